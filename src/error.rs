@@ -1,0 +1,78 @@
+//! The one error type of lookdev.
+//!
+//! Every failure is a single line that names the file (where there is one) and the problem. Bad
+//! input exits with code 2, everything else (a GPU or driver failure, an I/O failure while writing)
+//! with code 1.
+
+use std::fmt;
+use std::path::Path;
+
+/// What went wrong, which decides the exit code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ErrorKind {
+    /// A file, flag or value given by the user is wrong. Exit code 2.
+    Input,
+    /// The Vulkan driver, device or a kernel failed. Exit code 1.
+    Gpu,
+    /// Reading or writing failed for a reason that is not the input's fault. Exit code 1.
+    Io,
+}
+
+/// A one-line, user-facing error.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Error {
+    pub kind: ErrorKind,
+    pub message: String,
+}
+
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    /// Bad input in `file`: the message becomes `FILE: problem`.
+    pub fn input_file(file: impl AsRef<Path>, problem: impl fmt::Display) -> Self {
+        Error {
+            kind: ErrorKind::Input,
+            message: format!("{}: {}", file.as_ref().display(), problem),
+        }
+    }
+
+    /// Bad input that is not tied to a file, such as a command-line flag.
+    pub fn input(problem: impl fmt::Display) -> Self {
+        Error { kind: ErrorKind::Input, message: problem.to_string() }
+    }
+
+    pub fn gpu(problem: impl fmt::Display) -> Self {
+        Error { kind: ErrorKind::Gpu, message: problem.to_string() }
+    }
+
+    pub fn io(file: impl AsRef<Path>, problem: impl fmt::Display) -> Self {
+        Error {
+            kind: ErrorKind::Io,
+            message: format!("{}: {}", file.as_ref().display(), problem),
+        }
+    }
+
+    /// The process exit code for this error.
+    pub fn exit_code(&self) -> i32 {
+        match self.kind {
+            ErrorKind::Input => 2,
+            ErrorKind::Gpu | ErrorKind::Io => 1,
+        }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        // Keep it to one line, whatever the underlying library printed.
+        let one_line: Vec<&str> = self.message.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+        f.write_str(&one_line.join(" "))
+    }
+}
+
+impl std::error::Error for Error {}
+
+impl From<ash::vk::Result> for Error {
+    fn from(result: ash::vk::Result) -> Self {
+        Error::gpu(format!("Vulkan call failed: {result}"))
+    }
+}

@@ -1,0 +1,16 @@
+//! lookdev: a Vulkan compute look-dev relighter.
+//!
+//! Data flows one way: files are read into validated Rust types ([`gbuffer`], [`environment`],
+//! [`material`]), uploaded to the GPU ([`gpu`]), relit by compute kernels ([`render`]) and written
+//! out as images.
+
+pub mod error;
+pub mod material;
+pub mod render;
+
+pub use error::{Error, ErrorKind, Result};
+
+/// Prints a non-fatal warning to stderr, in the same one-line style as errors.
+pub fn warn(message: impl std::fmt::Display) {
+    eprintln!("lookdev: warning: {message}");
+}

@@ -1,0 +1,327 @@
+//! The eleven parameters of the Disney 2012 principled BRDF, their defaults, ranges and GPU layout.
+
+use std::fmt;
+
+/// Upper limits for the three parameters that may exceed 1 (Burley 2012, principle 4).
+/// `specular` 2.5 is F0 = 0.2, an IOR of about 2.6 (diamond is 2.42); `sheen` 2 doubles the
+/// retro-reflective rim; `clearcoat` 4 cancels the model's 0.25 factor, a full-strength IOR 1.5 coat.
+pub const SPECULAR_MAX: f32 = 2.5;
+pub const SHEEN_MAX: f32 = 2.0;
+pub const CLEARCOAT_MAX: f32 = 4.0;
+
+/// One BRDF parameter, by name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Param {
+    BaseColor,
+    Metallic,
+    Subsurface,
+    Specular,
+    SpecularTint,
+    Roughness,
+    Anisotropic,
+    Sheen,
+    SheenTint,
+    Clearcoat,
+    ClearcoatGloss,
+}
+
+impl Param {
+    /// All parameters, in the order of Burley's figure 16 and of the GPU layout.
+    pub const ALL: [Param; 11] = [
+        Param::BaseColor,
+        Param::Metallic,
+        Param::Subsurface,
+        Param::Specular,
+        Param::SpecularTint,
+        Param::Roughness,
+        Param::Anisotropic,
+        Param::Sheen,
+        Param::SheenTint,
+        Param::Clearcoat,
+        Param::ClearcoatGloss,
+    ];
+
+    /// The name used in presets, looks and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Param::BaseColor => "base_color",
+            Param::Metallic => "metallic",
+            Param::Subsurface => "subsurface",
+            Param::Specular => "specular",
+            Param::SpecularTint => "specular_tint",
+            Param::Roughness => "roughness",
+            Param::Anisotropic => "anisotropic",
+            Param::Sheen => "sheen",
+            Param::SheenTint => "sheen_tint",
+            Param::Clearcoat => "clearcoat",
+            Param::ClearcoatGloss => "clearcoat_gloss",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Param> {
+        Param::ALL.into_iter().find(|p| p.name() == name)
+    }
+
+    pub fn is_color(self) -> bool {
+        self == Param::BaseColor
+    }
+
+    /// The largest value allowed (the smallest is always 0).
+    pub fn max(self) -> f32 {
+        match self {
+            Param::Specular => SPECULAR_MAX,
+            Param::Sheen => SHEEN_MAX,
+            Param::Clearcoat => CLEARCOAT_MAX,
+            _ => 1.0,
+        }
+    }
+
+    /// The names of all parameters, for error messages.
+    pub fn all_names() -> String {
+        Param::ALL.map(Param::name).join(", ")
+    }
+}
+
+impl fmt::Display for Param {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A parameter value: a linear RGB colour for `base_color`, a scalar for everything else.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Value {
+    Scalar(f32),
+    Color([f32; 3]),
+}
+
+impl fmt::Display for Value {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Value::Scalar(v) => write!(f, "{v}"),
+            Value::Color([r, g, b]) => write!(f, "[{r}, {g}, {b}]"),
+        }
+    }
+}
+
+/// The eleven parameters of one material. All are normalised to [0, 1] except where
+/// [`Param::max`] allows more; colours are linear Rec.709.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Params {
+    pub base_color: [f32; 3],
+    pub metallic: f32,
+    pub subsurface: f32,
+    pub specular: f32,
+    pub specular_tint: f32,
+    pub roughness: f32,
+    pub anisotropic: f32,
+    pub sheen: f32,
+    pub sheen_tint: f32,
+    pub clearcoat: f32,
+    pub clearcoat_gloss: f32,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            base_color: [0.8, 0.8, 0.8],
+            metallic: 0.0,
+            subsurface: 0.0,
+            specular: 0.5,
+            specular_tint: 0.0,
+            roughness: 0.5,
+            anisotropic: 0.0,
+            sheen: 0.0,
+            sheen_tint: 0.5,
+            clearcoat: 0.0,
+            clearcoat_gloss: 1.0,
+        }
+    }
+}
+
+/// Number of floats in the GPU layout of [`Params`]: four vec4s.
+pub const GPU_FLOATS: usize = 16;
+
+impl Params {
+    pub fn get(&self, param: Param) -> Value {
+        match param {
+            Param::BaseColor => Value::Color(self.base_color),
+            _ => Value::Scalar(*self.scalar_mut_ref(param)),
+        }
+    }
+
+    /// Sets a parameter after checking its kind and range. The error says what is wrong, without
+    /// the file or line, which the caller adds.
+    pub fn set(&mut self, param: Param, value: Value) -> Result<(), String> {
+        check(param, value)?;
+        match (param, value) {
+            (Param::BaseColor, Value::Color(c)) => self.base_color = c,
+            (_, Value::Scalar(v)) => *self.scalar_mut(param) = v,
+            _ => unreachable!("check() rejects a mismatched kind"),
+        }
+        Ok(())
+    }
+
+    fn scalar_mut_ref(&self, param: Param) -> &f32 {
+        match param {
+            Param::Metallic => &self.metallic,
+            Param::Subsurface => &self.subsurface,
+            Param::Specular => &self.specular,
+            Param::SpecularTint => &self.specular_tint,
+            Param::Roughness => &self.roughness,
+            Param::Anisotropic => &self.anisotropic,
+            Param::Sheen => &self.sheen,
+            Param::SheenTint => &self.sheen_tint,
+            Param::Clearcoat => &self.clearcoat,
+            Param::ClearcoatGloss => &self.clearcoat_gloss,
+            Param::BaseColor => unreachable!("base_color is a colour"),
+        }
+    }
+
+    fn scalar_mut(&mut self, param: Param) -> &mut f32 {
+        match param {
+            Param::Metallic => &mut self.metallic,
+            Param::Subsurface => &mut self.subsurface,
+            Param::Specular => &mut self.specular,
+            Param::SpecularTint => &mut self.specular_tint,
+            Param::Roughness => &mut self.roughness,
+            Param::Anisotropic => &mut self.anisotropic,
+            Param::Sheen => &mut self.sheen,
+            Param::SheenTint => &mut self.sheen_tint,
+            Param::Clearcoat => &mut self.clearcoat,
+            Param::ClearcoatGloss => &mut self.clearcoat_gloss,
+            Param::BaseColor => unreachable!("base_color is a colour"),
+        }
+    }
+
+    /// The GPU layout, mirrored by `glsl/include/material.glsl`:
+    /// `[base_color.rgb, metallic] [subsurface, specular, specular_tint, roughness]
+    ///  [anisotropic, sheen, sheen_tint, clearcoat] [clearcoat_gloss, 0, 0, 0]`.
+    pub fn to_gpu(&self) -> [f32; GPU_FLOATS] {
+        let [r, g, b] = self.base_color;
+        [
+            r,
+            g,
+            b,
+            self.metallic,
+            self.subsurface,
+            self.specular,
+            self.specular_tint,
+            self.roughness,
+            self.anisotropic,
+            self.sheen,
+            self.sheen_tint,
+            self.clearcoat,
+            self.clearcoat_gloss,
+            0.0,
+            0.0,
+            0.0,
+        ]
+    }
+
+    pub fn from_gpu(v: &[f32; GPU_FLOATS]) -> Params {
+        Params {
+            base_color: [v[0], v[1], v[2]],
+            metallic: v[3],
+            subsurface: v[4],
+            specular: v[5],
+            specular_tint: v[6],
+            roughness: v[7],
+            anisotropic: v[8],
+            sheen: v[9],
+            sheen_tint: v[10],
+            clearcoat: v[11],
+            clearcoat_gloss: v[12],
+        }
+    }
+
+    /// Per-parameter linear blend, `mix(self, other, w)`: the layer-stack rule of LOOKDEV.md §3.
+    /// Written as `a·(1−w) + b·w`, as `resolve.comp` does, so that w = 1 gives `other` exactly.
+    pub fn mix(&self, other: &Params, w: f32) -> Params {
+        let a = self.to_gpu();
+        let b = other.to_gpu();
+        Params::from_gpu(&std::array::from_fn(|i| a[i] * (1.0 - w) + b[i] * w))
+    }
+}
+
+/// Checks that `value` has the right kind for `param` and lies in its range.
+pub fn check(param: Param, value: Value) -> Result<(), String> {
+    let max = param.max();
+    let in_range = |v: f32| v.is_finite() && (0.0..=max).contains(&v);
+    match (param.is_color(), value) {
+        (true, Value::Color(c)) => {
+            if c.iter().all(|&v| in_range(v)) {
+                Ok(())
+            } else {
+                Err(format!("{param} = {value} is out of range: each channel must be in [0, 1] (linear)"))
+            }
+        }
+        (false, Value::Scalar(v)) => {
+            if in_range(v) {
+                Ok(())
+            } else {
+                Err(format!("{param} = {v} is out of range [0, {max}]"))
+            }
+        }
+        (true, Value::Scalar(_)) => Err(format!("{param} is a colour: give three numbers [r, g, b]")),
+        (false, Value::Color(_)) => Err(format!("{param} is a number, not a colour")),
+    }
+}
+
+/// Parses a command-line value: `0.25` for scalars; `r,g,b` or a single grey value for colours.
+pub fn parse_value(param: Param, text: &str) -> Result<Value, String> {
+    let numbers: Result<Vec<f32>, _> = text.split(',').map(|s| s.trim().parse::<f32>()).collect();
+    let numbers = numbers.map_err(|_| format!("{param}: '{text}' is not a number"))?;
+    let value = match (param.is_color(), numbers.as_slice()) {
+        (true, [r, g, b]) => Value::Color([*r, *g, *b]),
+        (true, [grey]) => Value::Color([*grey; 3]),
+        (true, _) => return Err(format!("{param} takes r,g,b or one grey value, not '{text}'")),
+        (false, [v]) => Value::Scalar(*v),
+        (false, _) => return Err(format!("{param} takes one number, not '{text}'")),
+    };
+    check(param, value)?;
+    Ok(value)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_gpu_layout_is_invertible() {
+        for p in Param::ALL {
+            assert_eq!(Param::from_name(p.name()), Some(p));
+        }
+        let mut params = Params::default();
+        params.base_color = [0.1, 0.2, 0.3];
+        params.clearcoat_gloss = 0.7;
+        assert_eq!(Params::from_gpu(&params.to_gpu()), params);
+    }
+
+    #[test]
+    fn ranges_are_enforced() {
+        let mut p = Params::default();
+        assert!(p.set(Param::Roughness, Value::Scalar(1.01)).is_err());
+        assert!(p.set(Param::Roughness, Value::Scalar(f32::NAN)).is_err());
+        assert!(p.set(Param::Specular, Value::Scalar(2.0)).is_ok());
+        assert!(p.set(Param::Specular, Value::Scalar(2.6)).is_err());
+        assert!(p.set(Param::BaseColor, Value::Scalar(0.5)).is_err());
+        assert!(p.set(Param::BaseColor, Value::Color([0.5, -0.1, 0.2])).is_err());
+        assert_eq!(parse_value(Param::BaseColor, "0.9,0.6,0.3"), Ok(Value::Color([0.9, 0.6, 0.3])));
+        assert_eq!(parse_value(Param::Metallic, "1"), Ok(Value::Scalar(1.0)));
+        assert!(parse_value(Param::Metallic, "x").is_err());
+    }
+
+    #[test]
+    fn mix_is_per_parameter() {
+        let a = Params::default();
+        let mut b = Params::default();
+        b.roughness = 0.1;
+        b.base_color = [1.0, 0.0, 0.0];
+        let m = a.mix(&b, 0.5);
+        assert!((m.roughness - 0.3).abs() < 1e-6);
+        assert!((m.base_color[0] - 0.9).abs() < 1e-6 && (m.base_color[1] - 0.4).abs() < 1e-6);
+        assert_eq!(a.mix(&b, 0.0), a);
+        assert_eq!(a.mix(&b, 1.0), b);
+    }
+}

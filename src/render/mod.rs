@@ -1,0 +1,3 @@
+//! Rendering: parameter resolve, progressive relighting, accumulation and display transforms.
+
+pub mod tonemap;
