@@ -5,8 +5,10 @@
 //! out as images.
 
 pub mod error;
+pub mod gpu;
 pub mod material;
 pub mod render;
+pub mod shading;
 
 pub use error::{Error, ErrorKind, Result};
 

@@ -1,0 +1,35 @@
+// The eleven Disney parameters and their GPU layout: four vec4s, as Params::to_gpu writes them.
+#ifndef LOOKDEV_MATERIAL_GLSL
+#define LOOKDEV_MATERIAL_GLSL
+
+struct Material {
+    vec3 base_color;  // linear Rec.709
+    float metallic;
+    float subsurface;
+    float specular;
+    float specular_tint;
+    float roughness;
+    float anisotropic;
+    float sheen;
+    float sheen_tint;
+    float clearcoat;
+    float clearcoat_gloss;
+};
+
+Material unpack_material(vec4 p0, vec4 p1, vec4 p2, vec4 p3) {
+    Material m;
+    m.base_color = p0.rgb;
+    m.metallic = p0.a;
+    m.subsurface = p1.x;
+    m.specular = p1.y;
+    m.specular_tint = p1.z;
+    m.roughness = p1.w;
+    m.anisotropic = p2.x;
+    m.sheen = p2.y;
+    m.sheen_tint = p2.z;
+    m.clearcoat = p2.w;
+    m.clearcoat_gloss = p3.x;
+    return m;
+}
+
+#endif

@@ -1,0 +1,114 @@
+#version 460
+// One progressive pass of image-based relighting: for each covered pixel and each sample index,
+// one environment sample and one BRDF sample, combined with the power heuristic (LOOKDEV.md §5).
+// The running float32 sum is accumulated in sample order, so any split into passes gives the same
+// bits.
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#include "common.glsl"
+#include "material.glsl"
+#include "brdf.glsl"
+#include "sampling.glsl"
+#include "sobol.glsl"
+#include "environment.glsl"
+
+// Layer 0: N.xyz and coverage A; layer 1: V.xyz; layer 2: T.xyz (unit, orthogonal to N).
+layout(set = 0, binding = 0, rgba32f) uniform readonly image2DArray surface;
+// The resolved material, four layers as material.glsl unpacks them.
+layout(set = 0, binding = 1, rgba32f) uniform readonly image2DArray resolved;
+// Running sums: rgb radiance, a coverage.
+layout(set = 0, binding = 2, rgba32f) uniform image2D accumulation;
+
+layout(push_constant) uniform Pass {
+    uint first_sample;     // 0 starts a new accumulation
+    uint sample_count;
+    uint seed;
+    uint show_background;
+    float cos_rotation;
+    float sin_rotation;
+    float intensity;
+    uint image_width;
+} pass;
+
+// R_y(−rotation)·d: world to environment space.
+vec3 to_environment(vec3 d) {
+    return vec3(d.x * pass.cos_rotation - d.z * pass.sin_rotation, d.y,
+                d.x * pass.sin_rotation + d.z * pass.cos_rotation);
+}
+
+// One MIS estimate of reflected radiance toward v; the frame is the shading frame expressed in
+// environment space, so no per-sample rotation is needed.
+vec3 estimate(Lobes s, LobeChoice choice, vec3 v, vec3 fx, vec3 fy, vec3 fn, vec2 u_env, vec2 u_brdf) {
+    vec3 result = vec3(0.0);
+
+    vec2 uv;
+    float pdf_env;
+    vec3 d = env_sample(u_env, uv, pdf_env);
+    vec3 l = vec3(dot(d, fx), dot(d, fy), dot(d, fn));
+    if (l.z > 0.0 && pdf_env > 0.0) {
+        vec3 f = disney_brdf(s, l, v);
+        float pdf_brdf = brdf_pdf(s, choice, l, v);
+        result += f * (l.z * mis_weight_over_pdf(pdf_env, pdf_brdf)) * env_radiance(uv);
+    }
+
+    l = sample_brdf(s, choice, v, u_brdf);
+    if (l.z > 0.0) {
+        float pdf_brdf = brdf_pdf(s, choice, l, v);
+        if (pdf_brdf > 0.0) {
+            d = normalize(l.x * fx + l.y * fy + l.z * fn);
+            uv = env_direction_to_uv(d);
+            vec3 f = disney_brdf(s, l, v);
+            result += f * (l.z * mis_weight_over_pdf(pdf_brdf, env_pdf(uv, d))) * env_radiance(uv);
+        }
+    }
+    return result * pass.intensity;
+}
+
+void main() {
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 size = imageSize(accumulation);
+    if (pixel.x >= size.x || pixel.y >= size.y) {
+        return;
+    }
+    vec4 normal_coverage = imageLoad(surface, ivec3(pixel, 0));
+    vec3 view = imageLoad(surface, ivec3(pixel, 1)).xyz;
+    float coverage = normal_coverage.w;
+
+    vec3 background = vec3(0.0);
+    if (pass.show_background != 0u && coverage < 1.0) {
+        background = pass.intensity * env_radiance(env_direction_to_uv(to_environment(-view)));
+    }
+    vec4 sum = pass.first_sample == 0u ? vec4(0.0) : imageLoad(accumulation, pixel);
+    uint last = pass.first_sample + pass.sample_count;
+
+    if (coverage > 0.0) {
+        vec3 n = normal_coverage.xyz;
+        vec3 t = imageLoad(surface, ivec3(pixel, 2)).xyz;
+        vec3 b = cross(n, t);
+        vec3 v = vec3(dot(view, t), dot(view, b), dot(view, n));
+        Material m = unpack_material(imageLoad(resolved, ivec3(pixel, 0)), imageLoad(resolved, ivec3(pixel, 1)),
+                                     imageLoad(resolved, ivec3(pixel, 2)), imageLoad(resolved, ivec3(pixel, 3)));
+        Lobes s = make_lobes(m);
+        LobeChoice choice = choose_lobes(s, v.z);
+        vec3 fx = to_environment(t);
+        vec3 fy = to_environment(b);
+        vec3 fn = to_environment(n);
+        uint pixel_seed = hash_combine(hash_u32(pass.seed), uint(pixel.y) * pass.image_width + uint(pixel.x));
+        uint env_seed = hash_combine(pixel_seed, 0x454e56u);
+        uint brdf_seed = hash_combine(pixel_seed, 0x425244u);
+        for (uint i = pass.first_sample; i < last; i++) {
+            vec3 radiance = vec3(0.0);
+            if (v.z > 0.0) {
+                radiance = estimate(s, choice, v, fx, fy, fn, sobol_owen_2d(i, env_seed), sobol_owen_2d(i, brdf_seed));
+            }
+            sum += vec4(coverage * radiance + (1.0 - coverage) * background, coverage);
+        }
+    } else {
+        for (uint i = pass.first_sample; i < last; i++) {
+            sum += vec4(background, 0.0);
+        }
+    }
+    imageStore(accumulation, pixel, sum);
+}

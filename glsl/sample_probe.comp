@@ -1,0 +1,68 @@
+#version 460
+// Runs one sampling routine on a list of uniform random numbers, returning each sampled direction
+// and the pdf the renderer would use for it, for the chi-square tests. Also exposes the Sobol
+// sequence, to compare bit for bit with the Rust reference.
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 64) in;
+
+#include "brdf.glsl"
+#include "sampling.glsl"
+#include "sobol.glsl"
+#include "environment.glsl"
+
+const uint ROUTINE_COSINE = 0u;
+const uint ROUTINE_GGX = 1u;
+const uint ROUTINE_GTR1 = 2u;
+const uint ROUTINE_BRDF = 3u;
+const uint ROUTINE_ENVIRONMENT = 4u;
+const uint ROUTINE_SOBOL = 5u;
+
+layout(set = 0, binding = 0, std430) readonly buffer Setup {
+    vec4 params[4];
+    vec4 view;      // shading frame
+    uint routine;
+    uint seed;      // for ROUTINE_SOBOL
+};
+layout(set = 0, binding = 1, std430) readonly buffer Uniforms {
+    vec2 uniforms[];
+};
+// xyz: the direction (or, for Sobol, the point in xy); w: its pdf.
+layout(set = 0, binding = 2, std430) writeonly buffer Samples {
+    vec4 samples[];
+};
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= samples.length()) {
+        return;
+    }
+    Lobes s = make_lobes(unpack_material(params[0], params[1], params[2], params[3]));
+    LobeChoice choice = choose_lobes(s, view.z);
+    vec3 v = view.xyz;
+    vec2 u = uniforms[i];
+    vec4 result;
+    if (routine == ROUTINE_COSINE) {
+        vec3 l = sample_cosine(u);
+        result = vec4(l, pdf_cosine(l));
+    } else if (routine == ROUTINE_GGX) {
+        vec3 h = sample_ggx_visible_normal(v, s.ax, s.ay, u);
+        result = vec4(reflect(-v, h), pdf_ggx_reflection(v, h, s.ax, s.ay));
+    } else if (routine == ROUTINE_GTR1) {
+        vec3 h = sample_gtr1_normal(s.cc_alpha2, u);
+        result = vec4(reflect(-v, h), pdf_gtr1_reflection(v, h, s.cc_alpha2, s.cc_norm));
+    } else if (routine == ROUTINE_BRDF) {
+        vec3 l = sample_brdf(s, choice, v, u);
+        result = vec4(l, brdf_pdf(s, choice, l, v));
+    } else if (routine == ROUTINE_ENVIRONMENT) {
+        vec2 uv;
+        float pdf;
+        vec3 d = env_sample(u, uv, pdf);
+        // Also check that looking the pdf up from the direction agrees with the sampler's own.
+        float looked_up = env_pdf(env_direction_to_uv(d), d);
+        result = vec4(d, abs(looked_up - pdf) <= 1e-3 * pdf ? pdf : -1.0);
+    } else {
+        result = vec4(sobol_owen_2d(i, seed), 0.0, 0.0);
+    }
+    samples[i] = result;
+}

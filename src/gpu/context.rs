@@ -1,0 +1,413 @@
+//! The Vulkan context: instance, the chosen device, one compute queue and its command pool.
+
+use crate::{Error, Result};
+use ash::vk;
+use std::ffi::{c_void, CStr, CString};
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::Arc;
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+const INSTALL_DRIVER: &str = "install a Vulkan driver: on Debian or Ubuntu, `apt-get install mesa-vulkan-drivers libvulkan1` gives the lavapipe CPU driver";
+
+/// How to create a [`Context`].
+#[derive(Clone, Debug, Default)]
+pub struct ContextOptions {
+    /// Case-insensitive substring of the device name to use (lavapipe is "llvmpipe").
+    pub device_name: Option<String>,
+    /// Enable the Khronos validation layer (with synchronisation validation) and count errors.
+    pub validation: bool,
+}
+
+impl ContextOptions {
+    /// Validation follows the `LOOKDEV_VALIDATION` environment variable (`1` turns it on).
+    pub fn from_env(device_name: Option<String>) -> ContextOptions {
+        let validation = std::env::var("LOOKDEV_VALIDATION").is_ok_and(|v| v == "1");
+        ContextOptions {
+            device_name,
+            validation,
+        }
+    }
+}
+
+/// What the renderer needs to know about the chosen device.
+#[derive(Clone, Debug)]
+pub struct DeviceInfo {
+    pub name: String,
+    pub device_type: vk::PhysicalDeviceType,
+    pub api_version: u32,
+    /// Nanoseconds per timestamp tick, or None when the queue cannot write timestamps.
+    pub timestamp_period_ns: Option<f64>,
+    pub max_storage_buffer_range: u64,
+    pub max_image_dimension_2d: u32,
+    pub max_image_array_layers: u32,
+    pub subgroup_size: u32,
+}
+
+/// The validation message counter, shared with the debug callback.
+#[derive(Default)]
+pub struct ValidationCounter {
+    errors: AtomicU32,
+}
+
+impl ValidationCounter {
+    pub fn errors(&self) -> u32 {
+        self.errors.load(Ordering::SeqCst)
+    }
+}
+
+/// Everything that must outlive every buffer, image and pipeline; they hold an `Arc` to it, so the
+/// device is destroyed only after the last of them.
+pub struct Shared {
+    _entry: ash::Entry,
+    pub instance: ash::Instance,
+    debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    pub physical_device: vk::PhysicalDevice,
+    pub device: ash::Device,
+    pub queue: vk::Queue,
+    pub queue_family: u32,
+    pub memory_properties: vk::PhysicalDeviceMemoryProperties,
+    pub info: DeviceInfo,
+    command_pool: vk::CommandPool,
+    // Boxed so its address, handed to the debug callback, stays fixed.
+    _counter: Arc<ValidationCounter>,
+}
+
+impl Drop for Shared {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            self.device.destroy_command_pool(self.command_pool, None);
+            self.device.destroy_device(None);
+            if let Some((loader, messenger)) = self.debug.take() {
+                loader.destroy_debug_utils_messenger(messenger, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}
+
+/// The one Vulkan context of a process: instance, device, queue and memory allocation.
+#[derive(Clone)]
+pub struct Context {
+    pub shared: Arc<Shared>,
+    counter: Arc<ValidationCounter>,
+}
+
+impl std::ops::Deref for Context {
+    type Target = Shared;
+    fn deref(&self) -> &Shared {
+        &self.shared
+    }
+}
+
+unsafe extern "system" fn debug_callback(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    _types: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    user: *mut c_void,
+) -> vk::Bool32 {
+    let message = unsafe { data.as_ref().and_then(|d| d.message_as_c_str()) }
+        .map(|m| m.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
+        let counter = unsafe { &*(user as *const ValidationCounter) };
+        counter.errors.fetch_add(1, Ordering::SeqCst);
+        eprintln!("lookdev: validation error: {message}");
+    } else {
+        eprintln!("lookdev: validation warning: {message}");
+    }
+    vk::FALSE
+}
+
+fn rank(device_type: vk::PhysicalDeviceType) -> u32 {
+    match device_type {
+        vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+        vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+        vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+        vk::PhysicalDeviceType::CPU => 3,
+        _ => 4,
+    }
+}
+
+fn device_name(props: &vk::PhysicalDeviceProperties) -> String {
+    props
+        .device_name_as_c_str()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+impl Context {
+    /// Creates the context on the best device (discrete, then integrated, then CPU), or on the
+    /// one whose name contains `options.device_name`.
+    pub fn new(options: &ContextOptions) -> Result<Context> {
+        let entry = unsafe { ash::Entry::load() }
+            .map_err(|e| Error::gpu(format!("no Vulkan loader found ({e}); {INSTALL_DRIVER}")))?;
+        let counter = Arc::new(ValidationCounter::default());
+        let (instance, debug) = create_instance(&entry, options.validation, &counter)?;
+        let shared = match pick_and_create_device(entry, instance, debug, options, counter.clone())
+        {
+            Ok(shared) => shared,
+            Err(e) => return Err(e),
+        };
+        Ok(Context {
+            shared: Arc::new(shared),
+            counter,
+        })
+    }
+
+    /// Validation errors reported so far (always 0 when validation is off).
+    pub fn validation_errors(&self) -> u32 {
+        self.counter.errors()
+    }
+
+    /// The counter itself, to read after the context and everything it made are dropped (errors
+    /// about leaked objects arrive when the device is destroyed).
+    pub fn validation_counter(&self) -> Arc<ValidationCounter> {
+        self.counter.clone()
+    }
+
+    pub fn info(&self) -> &DeviceInfo {
+        &self.shared.info
+    }
+
+    /// Records commands with `record`, submits them and waits. A full memory barrier before and
+    /// after makes every submission see the results of the previous one.
+    pub fn run<T>(&self, record: impl FnOnce(vk::CommandBuffer) -> Result<T>) -> Result<T> {
+        let device = &self.device;
+        unsafe {
+            let alloc = vk::CommandBufferAllocateInfo::default()
+                .command_pool(self.command_pool)
+                .level(vk::CommandBufferLevel::PRIMARY)
+                .command_buffer_count(1);
+            let cmd = device.allocate_command_buffers(&alloc)?[0];
+            let fence = device.create_fence(&vk::FenceCreateInfo::default(), None)?;
+            let result = (|| {
+                device.begin_command_buffer(
+                    cmd,
+                    &vk::CommandBufferBeginInfo::default()
+                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                )?;
+                full_barrier(device, cmd);
+                let value = record(cmd)?;
+                full_barrier(device, cmd);
+                device.end_command_buffer(cmd)?;
+                let cmds = [cmd];
+                let submit = vk::SubmitInfo::default().command_buffers(&cmds);
+                device.queue_submit(self.queue, &[submit], fence)?;
+                device.wait_for_fences(&[fence], true, u64::MAX)?;
+                Ok(value)
+            })();
+            device.destroy_fence(fence, None);
+            device.free_command_buffers(self.command_pool, &[cmd]);
+            result
+        }
+    }
+}
+
+/// A barrier between everything before and everything after, within one command buffer.
+pub fn full_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
+    let barrier = vk::MemoryBarrier::default()
+        .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
+        .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE);
+    unsafe {
+        device.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::ALL_COMMANDS,
+            vk::PipelineStageFlags::ALL_COMMANDS,
+            vk::DependencyFlags::empty(),
+            &[barrier],
+            &[],
+            &[],
+        );
+    }
+}
+
+type DebugMessenger = Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>;
+
+fn create_instance(
+    entry: &ash::Entry,
+    validation: bool,
+    counter: &Arc<ValidationCounter>,
+) -> Result<(ash::Instance, DebugMessenger)> {
+    let app_name = CString::new("lookdev").expect("no interior NUL");
+    let app_info = vk::ApplicationInfo::default()
+        .application_name(&app_name)
+        .application_version(vk::make_api_version(0, 0, 1, 0))
+        .engine_name(&app_name)
+        .api_version(vk::API_VERSION_1_3);
+
+    let mut layers = Vec::new();
+    let mut extensions = Vec::new();
+    if validation {
+        let available = unsafe { entry.enumerate_instance_layer_properties() }?;
+        let found = available
+            .iter()
+            .any(|l| l.layer_name_as_c_str().is_ok_and(|n| n == VALIDATION_LAYER));
+        if !found {
+            return Err(Error::gpu(
+                "validation was requested (LOOKDEV_VALIDATION=1) but VK_LAYER_KHRONOS_validation is not installed: `apt-get install vulkan-validationlayers`",
+            ));
+        }
+        layers.push(VALIDATION_LAYER.as_ptr());
+        extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+        extensions.push(ash::ext::validation_features::NAME.as_ptr());
+    }
+    let enabled_features = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+    let mut validation_features =
+        vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_features);
+    let mut create_info = vk::InstanceCreateInfo::default()
+        .application_info(&app_info)
+        .enabled_layer_names(&layers)
+        .enabled_extension_names(&extensions);
+    if validation {
+        create_info = create_info.push_next(&mut validation_features);
+    }
+    let instance = unsafe { entry.create_instance(&create_info, None) }.map_err(|e| match e {
+        vk::Result::ERROR_INCOMPATIBLE_DRIVER => {
+            Error::gpu(format!("no Vulkan 1.3 driver found; {INSTALL_DRIVER}"))
+        }
+        other => Error::gpu(format!(
+            "cannot create a Vulkan instance ({other}); {INSTALL_DRIVER}"
+        )),
+    })?;
+
+    if !validation {
+        return Ok((instance, None));
+    }
+    let loader = ash::ext::debug_utils::Instance::new(entry, &instance);
+    let messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+        .message_severity(
+            vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
+        )
+        .message_type(
+            vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+        )
+        .pfn_user_callback(Some(debug_callback))
+        .user_data(Arc::as_ptr(counter) as *mut c_void);
+    let messenger = unsafe { loader.create_debug_utils_messenger(&messenger_info, None) }?;
+    Ok((instance, Some((loader, messenger))))
+}
+
+fn pick_and_create_device(
+    entry: ash::Entry,
+    instance: ash::Instance,
+    debug: DebugMessenger,
+    options: &ContextOptions,
+    counter: Arc<ValidationCounter>,
+) -> Result<Shared> {
+    // From here on, a failure must still destroy the instance.
+    let destroy_instance = |instance: &ash::Instance, debug: &DebugMessenger| unsafe {
+        if let Some((loader, messenger)) = debug {
+            loader.destroy_debug_utils_messenger(*messenger, None);
+        }
+        instance.destroy_instance(None);
+    };
+    let chosen = match choose_physical_device(&instance, options) {
+        Ok(chosen) => chosen,
+        Err(e) => {
+            destroy_instance(&instance, &debug);
+            return Err(e);
+        }
+    };
+    let (physical_device, queue_family, info) = chosen;
+    let priorities = [1.0f32];
+    let queue_info = [vk::DeviceQueueCreateInfo::default()
+        .queue_family_index(queue_family)
+        .queue_priorities(&priorities)];
+    // glslang's Vulkan 1.3 SPIR-V declares workgroup sizes with LocalSizeId, which needs maintenance4
+    // (core in 1.3 and supported by every 1.3 driver).
+    let mut features13 = vk::PhysicalDeviceVulkan13Features::default().maintenance4(true);
+    let device_info = vk::DeviceCreateInfo::default()
+        .queue_create_infos(&queue_info)
+        .push_next(&mut features13);
+    let device = match unsafe { instance.create_device(physical_device, &device_info, None) } {
+        Ok(device) => device,
+        Err(e) => {
+            destroy_instance(&instance, &debug);
+            return Err(Error::gpu(format!(
+                "cannot create a Vulkan device on {} ({e})",
+                info.name
+            )));
+        }
+    };
+    let queue = unsafe { device.get_device_queue(queue_family, 0) };
+    let memory_properties =
+        unsafe { instance.get_physical_device_memory_properties(physical_device) };
+    let pool_info = vk::CommandPoolCreateInfo::default()
+        .queue_family_index(queue_family)
+        .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+    let command_pool = unsafe { device.create_command_pool(&pool_info, None) }?;
+    Ok(Shared {
+        _entry: entry,
+        instance,
+        debug,
+        physical_device,
+        device,
+        queue,
+        queue_family,
+        memory_properties,
+        info,
+        command_pool,
+        _counter: counter,
+    })
+}
+
+fn choose_physical_device(
+    instance: &ash::Instance,
+    options: &ContextOptions,
+) -> Result<(vk::PhysicalDevice, u32, DeviceInfo)> {
+    let devices = unsafe { instance.enumerate_physical_devices() }?;
+    let mut candidates = Vec::new();
+    for pd in devices {
+        let props = unsafe { instance.get_physical_device_properties(pd) };
+        if props.api_version < vk::API_VERSION_1_3 {
+            continue;
+        }
+        let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
+        let Some(family) = families
+            .iter()
+            .position(|f| f.queue_flags.contains(vk::QueueFlags::COMPUTE))
+        else {
+            continue;
+        };
+        let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
+        unsafe { instance.get_physical_device_properties2(pd, &mut props2) };
+        let timestamps = families[family].timestamp_valid_bits > 0
+            && props.limits.timestamp_compute_and_graphics == vk::TRUE;
+        let info = DeviceInfo {
+            name: device_name(&props),
+            device_type: props.device_type,
+            api_version: props.api_version,
+            timestamp_period_ns: timestamps.then_some(props.limits.timestamp_period as f64),
+            max_storage_buffer_range: props.limits.max_storage_buffer_range as u64,
+            max_image_dimension_2d: props.limits.max_image_dimension2_d,
+            max_image_array_layers: props.limits.max_image_array_layers,
+            subgroup_size: subgroup.subgroup_size,
+        };
+        candidates.push((pd, family as u32, info));
+    }
+    if candidates.is_empty() {
+        return Err(Error::gpu(format!(
+            "no Vulkan 1.3 device with a compute queue was found; {INSTALL_DRIVER}"
+        )));
+    }
+    if let Some(wanted) = &options.device_name {
+        let wanted_lower = wanted.to_lowercase();
+        let names: Vec<String> = candidates.iter().map(|c| c.2.name.clone()).collect();
+        return candidates
+            .into_iter()
+            .find(|c| c.2.name.to_lowercase().contains(&wanted_lower))
+            .ok_or_else(|| {
+                Error::input(format!(
+                    "--device {wanted}: no such device (available: {})",
+                    names.join(", ")
+                ))
+            });
+    }
+    candidates.sort_by_key(|c| rank(c.2.device_type));
+    Ok(candidates.remove(0))
+}

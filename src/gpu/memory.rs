@@ -1,0 +1,387 @@
+//! Buffers and images, each with its own dedicated allocation.
+//!
+//! lookdev makes a few dozen long-lived, mostly large resources, far below any driver's
+//! allocation-count limit, so one allocation per resource is the simplest correct scheme.
+//! Images live in the GENERAL layout for their whole life: they are only ever used by compute
+//! kernels and transfers.
+
+use super::context::{Context, Shared};
+use crate::{Error, Result};
+use ash::vk;
+use std::sync::Arc;
+
+fn find_memory_type(
+    shared: &Shared,
+    type_bits: u32,
+    wanted: vk::MemoryPropertyFlags,
+) -> Option<u32> {
+    let props = &shared.memory_properties;
+    (0..props.memory_type_count).find(|&i| {
+        type_bits & (1 << i) != 0
+            && props.memory_types[i as usize]
+                .property_flags
+                .contains(wanted)
+    })
+}
+
+fn allocate(
+    shared: &Shared,
+    requirements: vk::MemoryRequirements,
+    host_visible: bool,
+) -> Result<vk::DeviceMemory> {
+    let preferred = if host_visible {
+        vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT
+    } else {
+        vk::MemoryPropertyFlags::DEVICE_LOCAL
+    };
+    let type_index = find_memory_type(shared, requirements.memory_type_bits, preferred)
+        .or_else(|| {
+            (!host_visible)
+                .then(|| {
+                    find_memory_type(
+                        shared,
+                        requirements.memory_type_bits,
+                        vk::MemoryPropertyFlags::empty(),
+                    )
+                })
+                .flatten()
+        })
+        .ok_or_else(|| Error::gpu("no suitable Vulkan memory type"))?;
+    let info = vk::MemoryAllocateInfo::default()
+        .allocation_size(requirements.size)
+        .memory_type_index(type_index);
+    unsafe { shared.device.allocate_memory(&info, None) }.map_err(|e| {
+        Error::gpu(format!(
+            "cannot allocate {} MiB of GPU memory ({e})",
+            requirements.size >> 20
+        ))
+    })
+}
+
+/// A storage or staging buffer.
+pub struct Buffer {
+    shared: Arc<Shared>,
+    pub buffer: vk::Buffer,
+    memory: vk::DeviceMemory,
+    pub size: u64,
+    mapped: Option<*mut u8>,
+}
+
+impl Buffer {
+    /// A device-local storage buffer that transfers can fill and read.
+    pub fn storage(ctx: &Context, size: u64) -> Result<Buffer> {
+        Buffer::new(
+            ctx,
+            size,
+            vk::BufferUsageFlags::STORAGE_BUFFER
+                | vk::BufferUsageFlags::TRANSFER_DST
+                | vk::BufferUsageFlags::TRANSFER_SRC,
+            false,
+        )
+    }
+
+    /// A host-visible, mapped buffer for uploads and read-backs.
+    pub fn staging(ctx: &Context, size: u64) -> Result<Buffer> {
+        Buffer::new(
+            ctx,
+            size,
+            vk::BufferUsageFlags::TRANSFER_SRC
+                | vk::BufferUsageFlags::TRANSFER_DST
+                | vk::BufferUsageFlags::STORAGE_BUFFER,
+            true,
+        )
+    }
+
+    fn new(
+        ctx: &Context,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        host_visible: bool,
+    ) -> Result<Buffer> {
+        let shared = ctx.shared.clone();
+        let size = size.max(16);
+        let info = vk::BufferCreateInfo::default()
+            .size(size)
+            .usage(usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        let device = &shared.device;
+        let buffer = unsafe { device.create_buffer(&info, None) }?;
+        let requirements = unsafe { device.get_buffer_memory_requirements(buffer) };
+        let memory = match allocate(&shared, requirements, host_visible) {
+            Ok(m) => m,
+            Err(e) => {
+                unsafe { device.destroy_buffer(buffer, None) };
+                return Err(e);
+            }
+        };
+        unsafe { device.bind_buffer_memory(buffer, memory, 0) }?;
+        let mapped = if host_visible {
+            Some(unsafe {
+                device.map_memory(memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty())
+            }? as *mut u8)
+        } else {
+            None
+        };
+        Ok(Buffer {
+            shared,
+            buffer,
+            memory,
+            size,
+            mapped,
+        })
+    }
+
+    /// The mapped bytes of a staging buffer.
+    pub fn bytes(&self) -> &[u8] {
+        let ptr = self.mapped.expect("only staging buffers are mapped");
+        unsafe { std::slice::from_raw_parts(ptr, self.size as usize) }
+    }
+
+    pub fn bytes_mut(&mut self) -> &mut [u8] {
+        let ptr = self.mapped.expect("only staging buffers are mapped");
+        unsafe { std::slice::from_raw_parts_mut(ptr, self.size as usize) }
+    }
+
+    /// A device-local storage buffer holding `data`.
+    pub fn with_data(ctx: &Context, data: &[u8]) -> Result<Buffer> {
+        let buffer = Buffer::storage(ctx, data.len() as u64)?;
+        let mut staging = Buffer::staging(ctx, data.len() as u64)?;
+        staging.bytes_mut()[..data.len()].copy_from_slice(data);
+        ctx.run(|cmd| {
+            let region = vk::BufferCopy::default().size(data.len().max(1) as u64);
+            unsafe {
+                ctx.device
+                    .cmd_copy_buffer(cmd, staging.buffer, buffer.buffer, &[region])
+            };
+            Ok(())
+        })?;
+        Ok(buffer)
+    }
+
+    /// Copies the whole buffer back to the host.
+    pub fn read(&self, ctx: &Context) -> Result<Vec<u8>> {
+        let staging = Buffer::staging(ctx, self.size)?;
+        ctx.run(|cmd| {
+            let region = vk::BufferCopy::default().size(self.size);
+            unsafe {
+                ctx.device
+                    .cmd_copy_buffer(cmd, self.buffer, staging.buffer, &[region])
+            };
+            Ok(())
+        })?;
+        Ok(staging.bytes().to_vec())
+    }
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        unsafe {
+            if self.mapped.is_some() {
+                self.shared.device.unmap_memory(self.memory);
+            }
+            self.shared.device.destroy_buffer(self.buffer, None);
+            self.shared.device.free_memory(self.memory, None);
+        }
+    }
+}
+
+/// A 2D storage image (optionally an array), always in the GENERAL layout.
+pub struct Image {
+    shared: Arc<Shared>,
+    pub image: vk::Image,
+    pub view: vk::ImageView,
+    memory: vk::DeviceMemory,
+    pub format: vk::Format,
+    pub width: u32,
+    pub height: u32,
+    pub layers: u32,
+}
+
+/// Bytes per texel of the formats lookdev uses.
+pub fn texel_size(format: vk::Format) -> u64 {
+    match format {
+        vk::Format::R32G32B32A32_SFLOAT => 16,
+        vk::Format::R32_SFLOAT | vk::Format::R32_UINT | vk::Format::R8G8B8A8_UNORM => 4,
+        other => panic!("texel_size: format {other:?} is not used by lookdev"),
+    }
+}
+
+impl Image {
+    /// A storage image of `layers` layers (a 2D array view when `layers` > 1 or `array` is set).
+    pub fn new(
+        ctx: &Context,
+        format: vk::Format,
+        width: u32,
+        height: u32,
+        layers: u32,
+        array: bool,
+    ) -> Result<Image> {
+        let max = ctx.info().max_image_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(Error::gpu(format!(
+                "a {width}x{height} image is outside what this device supports (1 to {max} pixels a side)"
+            )));
+        }
+        let shared = ctx.shared.clone();
+        let device = &shared.device;
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(format)
+            .extent(vk::Extent3D {
+                width,
+                height,
+                depth: 1,
+            })
+            .mip_levels(1)
+            .array_layers(layers)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(
+                vk::ImageUsageFlags::STORAGE
+                    | vk::ImageUsageFlags::TRANSFER_SRC
+                    | vk::ImageUsageFlags::TRANSFER_DST,
+            )
+            .sharing_mode(vk::SharingMode::EXCLUSIVE)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        let image = unsafe { device.create_image(&info, None) }?;
+        let requirements = unsafe { device.get_image_memory_requirements(image) };
+        let memory = match allocate(&shared, requirements, false) {
+            Ok(m) => m,
+            Err(e) => {
+                unsafe { device.destroy_image(image, None) };
+                return Err(e);
+            }
+        };
+        unsafe { device.bind_image_memory(image, memory, 0) }?;
+        let view_type = if array || layers > 1 {
+            vk::ImageViewType::TYPE_2D_ARRAY
+        } else {
+            vk::ImageViewType::TYPE_2D
+        };
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(image)
+            .view_type(view_type)
+            .format(format)
+            .subresource_range(Image::range(layers));
+        let view = unsafe { device.create_image_view(&view_info, None) }?;
+        let result = Image {
+            shared,
+            image,
+            view,
+            memory,
+            format,
+            width,
+            height,
+            layers,
+        };
+        ctx.run(|cmd| {
+            result.transition_to_general(cmd);
+            Ok(())
+        })?;
+        Ok(result)
+    }
+
+    fn range(layers: u32) -> vk::ImageSubresourceRange {
+        vk::ImageSubresourceRange::default()
+            .aspect_mask(vk::ImageAspectFlags::COLOR)
+            .level_count(1)
+            .layer_count(layers)
+    }
+
+    fn transition_to_general(&self, cmd: vk::CommandBuffer) {
+        let barrier = vk::ImageMemoryBarrier::default()
+            .src_access_mask(vk::AccessFlags::empty())
+            .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE)
+            .old_layout(vk::ImageLayout::UNDEFINED)
+            .new_layout(vk::ImageLayout::GENERAL)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(self.image)
+            .subresource_range(Image::range(self.layers));
+        unsafe {
+            self.shared.device.cmd_pipeline_barrier(
+                cmd,
+                vk::PipelineStageFlags::TOP_OF_PIPE,
+                vk::PipelineStageFlags::ALL_COMMANDS,
+                vk::DependencyFlags::empty(),
+                &[],
+                &[],
+                &[barrier],
+            );
+        }
+    }
+
+    pub fn byte_size(&self) -> u64 {
+        self.width as u64 * self.height as u64 * self.layers as u64 * texel_size(self.format)
+    }
+
+    fn copy_region(&self) -> vk::BufferImageCopy {
+        vk::BufferImageCopy::default()
+            .image_subresource(
+                vk::ImageSubresourceLayers::default()
+                    .aspect_mask(vk::ImageAspectFlags::COLOR)
+                    .layer_count(self.layers),
+            )
+            .image_extent(vk::Extent3D {
+                width: self.width,
+                height: self.height,
+                depth: 1,
+            })
+    }
+
+    /// Fills every layer from tightly packed texels, layer after layer, rows top to bottom.
+    pub fn upload(&self, ctx: &Context, data: &[u8]) -> Result<()> {
+        assert_eq!(
+            data.len() as u64,
+            self.byte_size(),
+            "upload size must match the image"
+        );
+        let mut staging = Buffer::staging(ctx, self.byte_size())?;
+        staging.bytes_mut()[..data.len()].copy_from_slice(data);
+        ctx.run(|cmd| {
+            unsafe {
+                ctx.device.cmd_copy_buffer_to_image(
+                    cmd,
+                    staging.buffer,
+                    self.image,
+                    vk::ImageLayout::GENERAL,
+                    &[self.copy_region()],
+                )
+            };
+            Ok(())
+        })
+    }
+
+    /// Records a copy of the whole image into `staging` (which must be large enough).
+    pub fn record_read(&self, cmd: vk::CommandBuffer, staging: &Buffer) {
+        unsafe {
+            self.shared.device.cmd_copy_image_to_buffer(
+                cmd,
+                self.image,
+                vk::ImageLayout::GENERAL,
+                staging.buffer,
+                &[self.copy_region()],
+            )
+        };
+    }
+
+    /// Copies every layer back to the host, tightly packed.
+    pub fn read(&self, ctx: &Context) -> Result<Vec<u8>> {
+        let staging = Buffer::staging(ctx, self.byte_size())?;
+        ctx.run(|cmd| {
+            self.record_read(cmd, &staging);
+            Ok(())
+        })?;
+        Ok(staging.bytes()[..self.byte_size() as usize].to_vec())
+    }
+}
+
+impl Drop for Image {
+    fn drop(&mut self) {
+        unsafe {
+            self.shared.device.destroy_image_view(self.view, None);
+            self.shared.device.destroy_image(self.image, None);
+            self.shared.device.free_memory(self.memory, None);
+        }
+    }
+}

@@ -1,0 +1,13 @@
+//! The Vulkan layer: one [`Context`] (instance, device, queue, memory), buffers and images,
+//! compute pipelines built from the committed SPIR-V, and GPU timestamps.
+
+pub mod context;
+pub mod memory;
+pub mod pipeline;
+pub mod shaders;
+pub mod timer;
+
+pub use context::{Context, ContextOptions, DeviceInfo};
+pub use memory::{Buffer, Image};
+pub use pipeline::{Binding, BindingKind, ComputePipeline, DescriptorSet};
+pub use timer::GpuTimer;

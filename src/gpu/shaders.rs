@@ -1,0 +1,31 @@
+//! The compute kernels, compiled from `glsl/` and committed in `spirv/`, so that a clean checkout
+//! builds without a shader compiler. `tests/spirv.rs` checks that the committed SPIR-V is current.
+
+/// One compute kernel's SPIR-V.
+pub struct Kernel {
+    pub name: &'static str,
+    pub spirv: &'static [u8],
+}
+
+macro_rules! kernel {
+    ($name:literal) => {
+        Kernel {
+            name: $name,
+            spirv: include_bytes!(concat!("../../spirv/", $name, ".comp.spv")),
+        }
+    };
+}
+
+/// Resolves layer stacks into one material per pixel.
+pub const RESOLVE: Kernel = kernel!("resolve");
+/// One progressive pass of MIS image-based lighting.
+pub const RELIGHT: Kernel = kernel!("relight");
+/// Mean, exposure, tone map and sRGB encoding.
+pub const DISPLAY: Kernel = kernel!("display");
+/// BRDF and pdf evaluation for the GPU-against-CPU tests.
+pub const BRDF_PROBE: Kernel = kernel!("brdf_probe");
+/// Sampling routines and the Sobol sequence, for the chi-square and sequence tests.
+pub const SAMPLE_PROBE: Kernel = kernel!("sample_probe");
+
+/// Every kernel, with the GLSL file it is compiled from (`glsl/<name>.comp`).
+pub const ALL: [&Kernel; 5] = [&RESOLVE, &RELIGHT, &DISPLAY, &BRDF_PROBE, &SAMPLE_PROBE];

@@ -1,0 +1,7 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+pub mod albedo;
+pub mod gpu;
+pub mod random;
+pub mod reference;
