@@ -17,6 +17,7 @@ const uint ROUTINE_GTR1 = 2u;
 const uint ROUTINE_BRDF = 3u;
 const uint ROUTINE_ENVIRONMENT = 4u;
 const uint ROUTINE_SOBOL = 5u;
+const uint ROUTINE_UV_ROUND_TRIP = 6u;
 
 layout(set = 0, binding = 0, std430) readonly buffer Setup {
     vec4 params[4];
@@ -61,8 +62,11 @@ void main() {
         // Also check that looking the pdf up from the direction agrees with the sampler's own.
         float looked_up = env_pdf(env_direction_to_uv(d), d);
         result = vec4(d, abs(looked_up - pdf) <= 1e-3 * pdf ? pdf : -1.0);
-    } else {
+    } else if (routine == ROUTINE_SOBOL) {
         result = vec4(sobol_owen_2d(i, seed), 0.0, 0.0);
+    } else {
+        vec3 d = env_uv_to_direction(u);
+        result = vec4(env_direction_to_uv(d), d.y, 0.0);
     }
     samples[i] = result;
 }

@@ -30,32 +30,20 @@ pub type Result<T> = std::result::Result<T, Error>;
 impl Error {
     /// Bad input in `file`: the message becomes `FILE: problem`.
     pub fn input_file(file: impl AsRef<Path>, problem: impl fmt::Display) -> Self {
-        Error {
-            kind: ErrorKind::Input,
-            message: format!("{}: {}", file.as_ref().display(), problem),
-        }
+        Error { kind: ErrorKind::Input, message: format!("{}: {}", file.as_ref().display(), problem) }
     }
 
     /// Bad input that is not tied to a file, such as a command-line flag.
     pub fn input(problem: impl fmt::Display) -> Self {
-        Error {
-            kind: ErrorKind::Input,
-            message: problem.to_string(),
-        }
+        Error { kind: ErrorKind::Input, message: problem.to_string() }
     }
 
     pub fn gpu(problem: impl fmt::Display) -> Self {
-        Error {
-            kind: ErrorKind::Gpu,
-            message: problem.to_string(),
-        }
+        Error { kind: ErrorKind::Gpu, message: problem.to_string() }
     }
 
     pub fn io(file: impl AsRef<Path>, problem: impl fmt::Display) -> Self {
-        Error {
-            kind: ErrorKind::Io,
-            message: format!("{}: {}", file.as_ref().display(), problem),
-        }
+        Error { kind: ErrorKind::Io, message: format!("{}: {}", file.as_ref().display(), problem) }
     }
 
     /// The process exit code for this error.
@@ -70,12 +58,7 @@ impl Error {
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         // Keep it to one line, whatever the underlying library printed.
-        let one_line: Vec<&str> = self
-            .message
-            .lines()
-            .map(str::trim)
-            .filter(|l| !l.is_empty())
-            .collect();
+        let one_line: Vec<&str> = self.message.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
         f.write_str(&one_line.join(" "))
     }
 }

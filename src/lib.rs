@@ -4,6 +4,7 @@
 //! [`material`]), uploaded to the GPU ([`gpu`]), relit by compute kernels ([`render`]) and written
 //! out as images.
 
+pub mod environment;
 pub mod error;
 pub mod gpu;
 pub mod material;

@@ -48,16 +48,9 @@ fn probe(ctx: &Context, records: &[Record]) -> Vec<[f32; 4]> {
     .unwrap();
     let input = Buffer::with_data(ctx, bytemuck::cast_slice(records)).unwrap();
     let output = Buffer::storage(ctx, (records.len() * 16) as u64).unwrap();
-    let set = pipeline
-        .bind(0, &[Binding::Buffer(&input), Binding::Buffer(&output)])
-        .unwrap();
+    let set = pipeline.bind(0, &[Binding::Buffer(&input), Binding::Buffer(&output)]).unwrap();
     ctx.run(|cmd| {
-        pipeline.dispatch(
-            cmd,
-            &[&set],
-            &[],
-            [(records.len() as u32).div_ceil(64), 1, 1],
-        );
+        pipeline.dispatch(cmd, &[&set], &[], [(records.len() as u32).div_ceil(64), 1, 1]);
         Ok(())
     })
     .unwrap();
@@ -83,11 +76,7 @@ fn gpu_brdf_and_pdf_match_the_rust_reference() {
             l.z = l.z.abs();
             v.z = v.z.abs();
         }
-        records.push(Record {
-            params: p.to_gpu(),
-            l: l.extend(0.0).to_array(),
-            v: v.extend(0.0).to_array(),
-        });
+        records.push(Record { params: p.to_gpu(), l: l.extend(0.0).to_array(), v: v.extend(0.0).to_array() });
         params.push(p);
     }
     let results = probe(&ctx, &records);
@@ -104,23 +93,13 @@ fn gpu_brdf_and_pdf_match_the_rust_reference() {
                 let err = relative_error(gpu, cpu);
                 worst = worst.max(err);
                 compared += 1;
-                assert!(
-                    err <= 1e-4,
-                    "record {i} channel {c}: GPU {gpu} vs CPU {cpu} ({:?}, l {l}, v {v})",
-                    params[i]
-                );
+                assert!(err <= 1e-4, "record {i} channel {c}: GPU {gpu} vs CPU {cpu} ({:?}, l {l}, v {v})", params[i]);
             } else {
-                assert!(
-                    gpu.abs() <= 2e-4,
-                    "record {i} channel {c}: GPU {gpu} vs CPU {cpu}"
-                );
+                assert!(gpu.abs() <= 2e-4, "record {i} channel {c}: GPU {gpu} vs CPU {cpu}");
             }
         }
     }
-    assert!(
-        compared > 20_000,
-        "only {compared} values were large enough to compare"
-    );
+    assert!(compared > 20_000, "only {compared} values were large enough to compare");
     eprintln!("{compared} values compared, worst relative error {worst:e}");
     common::gpu::finish(ctx);
 }
@@ -134,12 +113,8 @@ fn gpu_brdf_matches_the_reference_points() {
         .iter()
         .map(|p| Record {
             params: common::reference::params(p).to_gpu(),
-            l: common::reference::direction(&p["light"])
-                .extend(0.0)
-                .to_array(),
-            v: common::reference::direction(&p["view"])
-                .extend(0.0)
-                .to_array(),
+            l: common::reference::direction(&p["light"]).extend(0.0).to_array(),
+            v: common::reference::direction(&p["view"]).extend(0.0).to_array(),
         })
         .collect();
     let results = probe(&ctx, &records);

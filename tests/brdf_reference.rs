@@ -22,13 +22,7 @@ fn point_values_match_the_reference() {
         let expected = reference::vec3(&point["f"]);
         for c in 0..3 {
             let rel = (f[c] - expected[c]).abs() / expected[c].abs().max(1e-6);
-            assert!(
-                rel < 1e-5,
-                "{}: channel {c}: {} vs {}",
-                point["name"],
-                f[c],
-                expected[c]
-            );
+            assert!(rel < 1e-5, "{}: channel {c}: {} vs {}", point["name"], f[c], expected[c]);
         }
     }
 }
@@ -45,18 +39,11 @@ fn directional_albedo_matches_the_reference() {
         let angles = entry["theta_v"].as_array().unwrap();
         let albedos = entry["albedo"].as_array().unwrap();
         for (angle, expected) in angles.iter().zip(albedos) {
-            let angle = angle
-                .as_float()
-                .or(angle.as_integer().map(|i| i as f64))
-                .unwrap();
+            let angle = angle.as_float().or(angle.as_integer().map(|i| i as f64)).unwrap();
             let expected = expected.as_float().unwrap();
             let got = directional_albedo(&params, angle);
             // The reference rounds to 4 decimals.
-            assert!(
-                (got - expected).abs() < 4e-4,
-                "{} at {angle}°: {got} vs {expected}",
-                entry["name"]
-            );
+            assert!((got - expected).abs() < 4e-4, "{} at {angle}°: {got} vs {expected}", entry["name"]);
         }
     }
 }
@@ -68,11 +55,7 @@ fn closed_forms_hold() {
         let params = reference::params(entry);
         let expected = entry["albedo"].as_float().unwrap();
         let got = directional_albedo(&params, 0.0);
-        assert!(
-            (got - expected).abs() < 4e-4,
-            "{}: {got} vs {expected}",
-            entry["name"]
-        );
+        assert!((got - expected).abs() < 4e-4, "{}: {got} vs {expected}", entry["name"]);
     }
 }
 
@@ -81,10 +64,7 @@ fn grazing_and_below_horizon_give_zero_not_nan() {
     let lobes = make_lobes(&lookdev::material::Params::default());
     let grazing = Vec3::new(1.0, 0.0, 0.0);
     assert_eq!(disney_brdf(&lobes, grazing, grazing), Vec3::ZERO);
-    assert_eq!(
-        disney_brdf(&lobes, Vec3::new(0.0, 0.6, -0.8), Vec3::Z),
-        Vec3::ZERO
-    );
+    assert_eq!(disney_brdf(&lobes, Vec3::new(0.0, 0.6, -0.8), Vec3::Z), Vec3::ZERO);
     let f = disney_brdf(&lobes, Vec3::new(0.0, 1.0, 1e-7).normalize(), Vec3::Z);
     assert!(f.is_finite());
     // A white Lambertian-like check: the diffuse lobe alone at normal incidence is base/π·Fd.

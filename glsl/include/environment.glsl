@@ -28,10 +28,12 @@ layout(set = 1, binding = 3, std430) readonly buffer EnvCellPdf {
     float env_cell_pdf[];
 };
 
+// v = acos(d.y)/π, computed as atan2(|d.xz|, d.y)/π: the same angle for a unit d, but well
+// conditioned near the poles, and accurate where a driver's acos is only approximate.
 vec2 env_direction_to_uv(vec3 d) {
     float u = 0.5 + atan(d.x, -d.z) * INV_TWO_PI;
     u -= floor(u);
-    float v = acos(clamp(d.y, -1.0, 1.0)) * INV_PI;
+    float v = atan(length(d.xz), d.y) * INV_PI;
     return vec2(u, v);
 }
 

@@ -74,10 +74,14 @@ vec3 sample_gtr1_normal(float alpha2, vec2 u) {
     return vec3(sin_theta * cos(phi), sin_theta * sin(phi), sqrt(cos2));
 }
 
-// pdf of l = reflect(−v, h) for GTR1 half-vector sampling: D(h)·(N·h)/(4·v·h).
+// pdf of l = reflect(−v, h) for GTR1 half-vector sampling: D(h)·(N·h)/(4·|v·h|), where h is
+// ±normalize(l + v), whichever is in the upper hemisphere. GTR1 half vectors are not restricted
+// to those facing v, so a sample may reflect to below the horizon through a half vector opposite
+// to l + v; counting those keeps the pdf exact over the whole sphere.
 float pdf_gtr1_reflection(vec3 v, vec3 h, float alpha2, float norm) {
-    float vh = dot(v, h);
-    return h.z > 0.0 && vh > 0.0 ? gtr1(h, alpha2, norm) * h.z / (4.0 * vh) : 0.0;
+    h = h.z < 0.0 ? -h : h;
+    float vh = abs(dot(v, h));
+    return vh > 0.0 ? gtr1(h, alpha2, norm) * h.z / (4.0 * vh) : 0.0;
 }
 
 // The one-sample MIS pdf of sample_brdf: Σ pᵢ·pdfᵢ(l).

@@ -22,10 +22,7 @@ impl ContextOptions {
     /// Validation follows the `LOOKDEV_VALIDATION` environment variable (`1` turns it on).
     pub fn from_env(device_name: Option<String>) -> ContextOptions {
         let validation = std::env::var("LOOKDEV_VALIDATION").is_ok_and(|v| v == "1");
-        ContextOptions {
-            device_name,
-            validation,
-        }
+        ContextOptions { device_name, validation }
     }
 }
 
@@ -130,10 +127,7 @@ fn rank(device_type: vk::PhysicalDeviceType) -> u32 {
 }
 
 fn device_name(props: &vk::PhysicalDeviceProperties) -> String {
-    props
-        .device_name_as_c_str()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default()
+    props.device_name_as_c_str().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
 }
 
 impl Context {
@@ -144,15 +138,11 @@ impl Context {
             .map_err(|e| Error::gpu(format!("no Vulkan loader found ({e}); {INSTALL_DRIVER}")))?;
         let counter = Arc::new(ValidationCounter::default());
         let (instance, debug) = create_instance(&entry, options.validation, &counter)?;
-        let shared = match pick_and_create_device(entry, instance, debug, options, counter.clone())
-        {
+        let shared = match pick_and_create_device(entry, instance, debug, options, counter.clone()) {
             Ok(shared) => shared,
             Err(e) => return Err(e),
         };
-        Ok(Context {
-            shared: Arc::new(shared),
-            counter,
-        })
+        Ok(Context { shared: Arc::new(shared), counter })
     }
 
     /// Validation errors reported so far (always 0 when validation is off).
@@ -184,8 +174,7 @@ impl Context {
             let result = (|| {
                 device.begin_command_buffer(
                     cmd,
-                    &vk::CommandBufferBeginInfo::default()
-                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                    &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
                 )?;
                 full_barrier(device, cmd);
                 let value = record(cmd)?;
@@ -240,9 +229,7 @@ fn create_instance(
     let mut extensions = Vec::new();
     if validation {
         let available = unsafe { entry.enumerate_instance_layer_properties() }?;
-        let found = available
-            .iter()
-            .any(|l| l.layer_name_as_c_str().is_ok_and(|n| n == VALIDATION_LAYER));
+        let found = available.iter().any(|l| l.layer_name_as_c_str().is_ok_and(|n| n == VALIDATION_LAYER));
         if !found {
             return Err(Error::gpu(
                 "validation was requested (LOOKDEV_VALIDATION=1) but VK_LAYER_KHRONOS_validation is not installed: `apt-get install vulkan-validationlayers`",
@@ -253,8 +240,7 @@ fn create_instance(
         extensions.push(ash::ext::validation_features::NAME.as_ptr());
     }
     let enabled_features = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
-    let mut validation_features =
-        vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_features);
+    let mut validation_features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_features);
     let mut create_info = vk::InstanceCreateInfo::default()
         .application_info(&app_info)
         .enabled_layer_names(&layers)
@@ -263,12 +249,8 @@ fn create_instance(
         create_info = create_info.push_next(&mut validation_features);
     }
     let instance = unsafe { entry.create_instance(&create_info, None) }.map_err(|e| match e {
-        vk::Result::ERROR_INCOMPATIBLE_DRIVER => {
-            Error::gpu(format!("no Vulkan 1.3 driver found; {INSTALL_DRIVER}"))
-        }
-        other => Error::gpu(format!(
-            "cannot create a Vulkan instance ({other}); {INSTALL_DRIVER}"
-        )),
+        vk::Result::ERROR_INCOMPATIBLE_DRIVER => Error::gpu(format!("no Vulkan 1.3 driver found; {INSTALL_DRIVER}")),
+        other => Error::gpu(format!("cannot create a Vulkan instance ({other}); {INSTALL_DRIVER}")),
     })?;
 
     if !validation {
@@ -276,14 +258,10 @@ fn create_instance(
     }
     let loader = ash::ext::debug_utils::Instance::new(entry, &instance);
     let messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
-        .message_severity(
-            vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
-                | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
-        )
+        .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING)
         .message_type(
-            vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
-                | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
-                | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+            // Performance hints are left out: they flag lookdev's deliberate use of the GENERAL layout.
+            vk::DebugUtilsMessageTypeFlagsEXT::GENERAL | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION,
         )
         .pfn_user_callback(Some(debug_callback))
         .user_data(Arc::as_ptr(counter) as *mut c_void);
@@ -314,28 +292,21 @@ fn pick_and_create_device(
     };
     let (physical_device, queue_family, info) = chosen;
     let priorities = [1.0f32];
-    let queue_info = [vk::DeviceQueueCreateInfo::default()
-        .queue_family_index(queue_family)
-        .queue_priorities(&priorities)];
+    let queue_info =
+        [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
     // glslang's Vulkan 1.3 SPIR-V declares workgroup sizes with LocalSizeId, which needs maintenance4
     // (core in 1.3 and supported by every 1.3 driver).
     let mut features13 = vk::PhysicalDeviceVulkan13Features::default().maintenance4(true);
-    let device_info = vk::DeviceCreateInfo::default()
-        .queue_create_infos(&queue_info)
-        .push_next(&mut features13);
+    let device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_info).push_next(&mut features13);
     let device = match unsafe { instance.create_device(physical_device, &device_info, None) } {
         Ok(device) => device,
         Err(e) => {
             destroy_instance(&instance, &debug);
-            return Err(Error::gpu(format!(
-                "cannot create a Vulkan device on {} ({e})",
-                info.name
-            )));
+            return Err(Error::gpu(format!("cannot create a Vulkan device on {} ({e})", info.name)));
         }
     };
     let queue = unsafe { device.get_device_queue(queue_family, 0) };
-    let memory_properties =
-        unsafe { instance.get_physical_device_memory_properties(physical_device) };
+    let memory_properties = unsafe { instance.get_physical_device_memory_properties(physical_device) };
     let pool_info = vk::CommandPoolCreateInfo::default()
         .queue_family_index(queue_family)
         .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
@@ -367,17 +338,14 @@ fn choose_physical_device(
             continue;
         }
         let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
-        let Some(family) = families
-            .iter()
-            .position(|f| f.queue_flags.contains(vk::QueueFlags::COMPUTE))
-        else {
+        let Some(family) = families.iter().position(|f| f.queue_flags.contains(vk::QueueFlags::COMPUTE)) else {
             continue;
         };
         let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
         let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
         unsafe { instance.get_physical_device_properties2(pd, &mut props2) };
-        let timestamps = families[family].timestamp_valid_bits > 0
-            && props.limits.timestamp_compute_and_graphics == vk::TRUE;
+        let timestamps =
+            families[family].timestamp_valid_bits > 0 && props.limits.timestamp_compute_and_graphics == vk::TRUE;
         let info = DeviceInfo {
             name: device_name(&props),
             device_type: props.device_type,
@@ -391,22 +359,14 @@ fn choose_physical_device(
         candidates.push((pd, family as u32, info));
     }
     if candidates.is_empty() {
-        return Err(Error::gpu(format!(
-            "no Vulkan 1.3 device with a compute queue was found; {INSTALL_DRIVER}"
-        )));
+        return Err(Error::gpu(format!("no Vulkan 1.3 device with a compute queue was found; {INSTALL_DRIVER}")));
     }
     if let Some(wanted) = &options.device_name {
         let wanted_lower = wanted.to_lowercase();
         let names: Vec<String> = candidates.iter().map(|c| c.2.name.clone()).collect();
-        return candidates
-            .into_iter()
-            .find(|c| c.2.name.to_lowercase().contains(&wanted_lower))
-            .ok_or_else(|| {
-                Error::input(format!(
-                    "--device {wanted}: no such device (available: {})",
-                    names.join(", ")
-                ))
-            });
+        return candidates.into_iter().find(|c| c.2.name.to_lowercase().contains(&wanted_lower)).ok_or_else(|| {
+            Error::input(format!("--device {wanted}: no such device (available: {})", names.join(", ")))
+        });
     }
     candidates.sort_by_key(|c| rank(c.2.device_type));
     Ok(candidates.remove(0))

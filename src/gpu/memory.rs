@@ -10,25 +10,13 @@ use crate::{Error, Result};
 use ash::vk;
 use std::sync::Arc;
 
-fn find_memory_type(
-    shared: &Shared,
-    type_bits: u32,
-    wanted: vk::MemoryPropertyFlags,
-) -> Option<u32> {
+fn find_memory_type(shared: &Shared, type_bits: u32, wanted: vk::MemoryPropertyFlags) -> Option<u32> {
     let props = &shared.memory_properties;
-    (0..props.memory_type_count).find(|&i| {
-        type_bits & (1 << i) != 0
-            && props.memory_types[i as usize]
-                .property_flags
-                .contains(wanted)
-    })
+    (0..props.memory_type_count)
+        .find(|&i| type_bits & (1 << i) != 0 && props.memory_types[i as usize].property_flags.contains(wanted))
 }
 
-fn allocate(
-    shared: &Shared,
-    requirements: vk::MemoryRequirements,
-    host_visible: bool,
-) -> Result<vk::DeviceMemory> {
+fn allocate(shared: &Shared, requirements: vk::MemoryRequirements, host_visible: bool) -> Result<vk::DeviceMemory> {
     let preferred = if host_visible {
         vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT
     } else {
@@ -37,25 +25,13 @@ fn allocate(
     let type_index = find_memory_type(shared, requirements.memory_type_bits, preferred)
         .or_else(|| {
             (!host_visible)
-                .then(|| {
-                    find_memory_type(
-                        shared,
-                        requirements.memory_type_bits,
-                        vk::MemoryPropertyFlags::empty(),
-                    )
-                })
+                .then(|| find_memory_type(shared, requirements.memory_type_bits, vk::MemoryPropertyFlags::empty()))
                 .flatten()
         })
         .ok_or_else(|| Error::gpu("no suitable Vulkan memory type"))?;
-    let info = vk::MemoryAllocateInfo::default()
-        .allocation_size(requirements.size)
-        .memory_type_index(type_index);
-    unsafe { shared.device.allocate_memory(&info, None) }.map_err(|e| {
-        Error::gpu(format!(
-            "cannot allocate {} MiB of GPU memory ({e})",
-            requirements.size >> 20
-        ))
-    })
+    let info = vk::MemoryAllocateInfo::default().allocation_size(requirements.size).memory_type_index(type_index);
+    unsafe { shared.device.allocate_memory(&info, None) }
+        .map_err(|e| Error::gpu(format!("cannot allocate {} MiB of GPU memory ({e})", requirements.size >> 20)))
 }
 
 /// A storage or staging buffer.
@@ -92,18 +68,10 @@ impl Buffer {
         )
     }
 
-    fn new(
-        ctx: &Context,
-        size: u64,
-        usage: vk::BufferUsageFlags,
-        host_visible: bool,
-    ) -> Result<Buffer> {
+    fn new(ctx: &Context, size: u64, usage: vk::BufferUsageFlags, host_visible: bool) -> Result<Buffer> {
         let shared = ctx.shared.clone();
         let size = size.max(16);
-        let info = vk::BufferCreateInfo::default()
-            .size(size)
-            .usage(usage)
-            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        let info = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
         let device = &shared.device;
         let buffer = unsafe { device.create_buffer(&info, None) }?;
         let requirements = unsafe { device.get_buffer_memory_requirements(buffer) };
@@ -116,19 +84,11 @@ impl Buffer {
         };
         unsafe { device.bind_buffer_memory(buffer, memory, 0) }?;
         let mapped = if host_visible {
-            Some(unsafe {
-                device.map_memory(memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty())
-            }? as *mut u8)
+            Some(unsafe { device.map_memory(memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }? as *mut u8)
         } else {
             None
         };
-        Ok(Buffer {
-            shared,
-            buffer,
-            memory,
-            size,
-            mapped,
-        })
+        Ok(Buffer { shared, buffer, memory, size, mapped })
     }
 
     /// The mapped bytes of a staging buffer.
@@ -149,10 +109,7 @@ impl Buffer {
         staging.bytes_mut()[..data.len()].copy_from_slice(data);
         ctx.run(|cmd| {
             let region = vk::BufferCopy::default().size(data.len().max(1) as u64);
-            unsafe {
-                ctx.device
-                    .cmd_copy_buffer(cmd, staging.buffer, buffer.buffer, &[region])
-            };
+            unsafe { ctx.device.cmd_copy_buffer(cmd, staging.buffer, buffer.buffer, &[region]) };
             Ok(())
         })?;
         Ok(buffer)
@@ -163,10 +120,7 @@ impl Buffer {
         let staging = Buffer::staging(ctx, self.size)?;
         ctx.run(|cmd| {
             let region = vk::BufferCopy::default().size(self.size);
-            unsafe {
-                ctx.device
-                    .cmd_copy_buffer(cmd, self.buffer, staging.buffer, &[region])
-            };
+            unsafe { ctx.device.cmd_copy_buffer(cmd, self.buffer, staging.buffer, &[region]) };
             Ok(())
         })?;
         Ok(staging.bytes().to_vec())
@@ -208,14 +162,7 @@ pub fn texel_size(format: vk::Format) -> u64 {
 
 impl Image {
     /// A storage image of `layers` layers (a 2D array view when `layers` > 1 or `array` is set).
-    pub fn new(
-        ctx: &Context,
-        format: vk::Format,
-        width: u32,
-        height: u32,
-        layers: u32,
-        array: bool,
-    ) -> Result<Image> {
+    pub fn new(ctx: &Context, format: vk::Format, width: u32, height: u32, layers: u32, array: bool) -> Result<Image> {
         let max = ctx.info().max_image_dimension_2d;
         if width == 0 || height == 0 || width > max || height > max {
             return Err(Error::gpu(format!(
@@ -227,20 +174,12 @@ impl Image {
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
-            .extent(vk::Extent3D {
-                width,
-                height,
-                depth: 1,
-            })
+            .extent(vk::Extent3D { width, height, depth: 1 })
             .mip_levels(1)
             .array_layers(layers)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
-            .usage(
-                vk::ImageUsageFlags::STORAGE
-                    | vk::ImageUsageFlags::TRANSFER_SRC
-                    | vk::ImageUsageFlags::TRANSFER_DST,
-            )
+            .usage(vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST)
             .sharing_mode(vk::SharingMode::EXCLUSIVE)
             .initial_layout(vk::ImageLayout::UNDEFINED);
         let image = unsafe { device.create_image(&info, None) }?;
@@ -253,27 +192,14 @@ impl Image {
             }
         };
         unsafe { device.bind_image_memory(image, memory, 0) }?;
-        let view_type = if array || layers > 1 {
-            vk::ImageViewType::TYPE_2D_ARRAY
-        } else {
-            vk::ImageViewType::TYPE_2D
-        };
+        let view_type = if array || layers > 1 { vk::ImageViewType::TYPE_2D_ARRAY } else { vk::ImageViewType::TYPE_2D };
         let view_info = vk::ImageViewCreateInfo::default()
             .image(image)
             .view_type(view_type)
             .format(format)
             .subresource_range(Image::range(layers));
         let view = unsafe { device.create_image_view(&view_info, None) }?;
-        let result = Image {
-            shared,
-            image,
-            view,
-            memory,
-            format,
-            width,
-            height,
-            layers,
-        };
+        let result = Image { shared, image, view, memory, format, width, height, layers };
         ctx.run(|cmd| {
             result.transition_to_general(cmd);
             Ok(())
@@ -282,10 +208,7 @@ impl Image {
     }
 
     fn range(layers: u32) -> vk::ImageSubresourceRange {
-        vk::ImageSubresourceRange::default()
-            .aspect_mask(vk::ImageAspectFlags::COLOR)
-            .level_count(1)
-            .layer_count(layers)
+        vk::ImageSubresourceRange::default().aspect_mask(vk::ImageAspectFlags::COLOR).level_count(1).layer_count(layers)
     }
 
     fn transition_to_general(&self, cmd: vk::CommandBuffer) {
@@ -318,24 +241,14 @@ impl Image {
     fn copy_region(&self) -> vk::BufferImageCopy {
         vk::BufferImageCopy::default()
             .image_subresource(
-                vk::ImageSubresourceLayers::default()
-                    .aspect_mask(vk::ImageAspectFlags::COLOR)
-                    .layer_count(self.layers),
+                vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(self.layers),
             )
-            .image_extent(vk::Extent3D {
-                width: self.width,
-                height: self.height,
-                depth: 1,
-            })
+            .image_extent(vk::Extent3D { width: self.width, height: self.height, depth: 1 })
     }
 
     /// Fills every layer from tightly packed texels, layer after layer, rows top to bottom.
     pub fn upload(&self, ctx: &Context, data: &[u8]) -> Result<()> {
-        assert_eq!(
-            data.len() as u64,
-            self.byte_size(),
-            "upload size must match the image"
-        );
+        assert_eq!(data.len() as u64, self.byte_size(), "upload size must match the image");
         let mut staging = Buffer::staging(ctx, self.byte_size())?;
         staging.bytes_mut()[..data.len()].copy_from_slice(data);
         ctx.run(|cmd| {

@@ -42,18 +42,11 @@ pub struct ComputePipeline {
 }
 
 impl ComputePipeline {
-    pub fn new(
-        ctx: &Context,
-        kernel: &Kernel,
-        sets: &[&[BindingKind]],
-        push_size: u32,
-    ) -> Result<ComputePipeline> {
+    pub fn new(ctx: &Context, kernel: &Kernel, sets: &[&[BindingKind]], push_size: u32) -> Result<ComputePipeline> {
         let device = &ctx.device;
         let code = ash::util::read_spv(&mut std::io::Cursor::new(kernel.spirv))
             .map_err(|e| Error::gpu(format!("kernel {}: bad SPIR-V ({e})", kernel.name)))?;
-        let module = unsafe {
-            device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&code), None)
-        }?;
+        let module = unsafe { device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&code), None) }?;
 
         let mut set_layouts = Vec::new();
         for kinds in sets {
@@ -71,9 +64,7 @@ impl ComputePipeline {
             let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
             set_layouts.push(unsafe { device.create_descriptor_set_layout(&info, None) }?);
         }
-        let ranges = [vk::PushConstantRange::default()
-            .stage_flags(vk::ShaderStageFlags::COMPUTE)
-            .size(push_size)];
+        let ranges = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::COMPUTE).size(push_size)];
         let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
         if push_size > 0 {
             layout_info = layout_info.push_constant_ranges(&ranges);
@@ -83,18 +74,11 @@ impl ComputePipeline {
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module)
             .name(c"main");
-        let info = vk::ComputePipelineCreateInfo::default()
-            .stage(stage)
-            .layout(layout);
-        let pipeline =
-            unsafe { device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
+        let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout);
+        let pipeline = unsafe { device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
         unsafe { device.destroy_shader_module(module, None) };
-        let pipeline = pipeline.map_err(|(_, e)| {
-            Error::gpu(format!(
-                "kernel {}: pipeline creation failed ({e})",
-                kernel.name
-            ))
-        })?[0];
+        let pipeline = pipeline
+            .map_err(|(_, e)| Error::gpu(format!("kernel {}: pipeline creation failed ({e})", kernel.name)))?[0];
         Ok(ComputePipeline {
             shared: ctx.shared.clone(),
             name: kernel.name,
@@ -109,42 +93,18 @@ impl ComputePipeline {
     /// Makes descriptor set `set` from `bindings`, which must match the layout.
     pub fn bind(&self, set: usize, bindings: &[Binding]) -> Result<DescriptorSet> {
         let kinds = &self.set_kinds[set];
-        assert_eq!(
-            kinds.len(),
-            bindings.len(),
-            "kernel {}: set {set} needs {} bindings",
-            self.name,
-            kinds.len()
-        );
+        assert_eq!(kinds.len(), bindings.len(), "kernel {}: set {set} needs {} bindings", self.name, kinds.len());
         DescriptorSet::new(&self.shared, self.set_layouts[set], kinds, bindings)
     }
 
     /// Records a dispatch of `groups` workgroups with the given sets and push constants.
-    pub fn dispatch(
-        &self,
-        cmd: vk::CommandBuffer,
-        sets: &[&DescriptorSet],
-        push: &[u8],
-        groups: [u32; 3],
-    ) {
-        assert_eq!(
-            push.len() as u32,
-            self.push_size,
-            "kernel {}: push constant size",
-            self.name
-        );
+    pub fn dispatch(&self, cmd: vk::CommandBuffer, sets: &[&DescriptorSet], push: &[u8], groups: [u32; 3]) {
+        assert_eq!(push.len() as u32, self.push_size, "kernel {}: push constant size", self.name);
         let device = &self.shared.device;
         let handles: Vec<_> = sets.iter().map(|s| s.set).collect();
         unsafe {
             device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
-            device.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::COMPUTE,
-                self.layout,
-                0,
-                &handles,
-                &[],
-            );
+            device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &handles, &[]);
             if !push.is_empty() {
                 device.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
             }
@@ -185,21 +145,14 @@ impl DescriptorSet {
             .into_iter()
             .filter_map(|kind| {
                 let count = kinds.iter().filter(|k| **k == kind).count() as u32;
-                (count > 0).then(|| {
-                    vk::DescriptorPoolSize::default()
-                        .ty(kind.descriptor_type())
-                        .descriptor_count(count)
-                })
+                (count > 0)
+                    .then(|| vk::DescriptorPoolSize::default().ty(kind.descriptor_type()).descriptor_count(count))
             })
             .collect();
-        let pool_info = vk::DescriptorPoolCreateInfo::default()
-            .max_sets(1)
-            .pool_sizes(&sizes);
+        let pool_info = vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes);
         let pool = unsafe { device.create_descriptor_pool(&pool_info, None) }?;
         let layouts = [layout];
-        let alloc = vk::DescriptorSetAllocateInfo::default()
-            .descriptor_pool(pool)
-            .set_layouts(&layouts);
+        let alloc = vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts);
         let set = match unsafe { device.allocate_descriptor_sets(&alloc) } {
             Ok(sets) => sets[0],
             Err(e) => {
@@ -210,18 +163,18 @@ impl DescriptorSet {
         let image_infos: Vec<[vk::DescriptorImageInfo; 1]> = bindings
             .iter()
             .map(|b| match b {
-                Binding::Image(image) => [vk::DescriptorImageInfo::default()
-                    .image_view(image.view)
-                    .image_layout(vk::ImageLayout::GENERAL)],
+                Binding::Image(image) => {
+                    [vk::DescriptorImageInfo::default().image_view(image.view).image_layout(vk::ImageLayout::GENERAL)]
+                }
                 Binding::Buffer(_) => [vk::DescriptorImageInfo::default()],
             })
             .collect();
         let buffer_infos: Vec<[vk::DescriptorBufferInfo; 1]> = bindings
             .iter()
             .map(|b| match b {
-                Binding::Buffer(buffer) => [vk::DescriptorBufferInfo::default()
-                    .buffer(buffer.buffer)
-                    .range(vk::WHOLE_SIZE)],
+                Binding::Buffer(buffer) => {
+                    [vk::DescriptorBufferInfo::default().buffer(buffer.buffer).range(vk::WHOLE_SIZE)]
+                }
                 Binding::Image(_) => [vk::DescriptorBufferInfo::default()],
             })
             .collect();
@@ -248,11 +201,7 @@ impl DescriptorSet {
             })
             .collect();
         unsafe { device.update_descriptor_sets(&writes, &[]) };
-        Ok(DescriptorSet {
-            shared: shared.clone(),
-            pool,
-            set,
-        })
+        Ok(DescriptorSet { shared: shared.clone(), pool, set })
     }
 }
 

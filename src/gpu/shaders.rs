@@ -9,10 +9,7 @@ pub struct Kernel {
 
 macro_rules! kernel {
     ($name:literal) => {
-        Kernel {
-            name: $name,
-            spirv: include_bytes!(concat!("../../spirv/", $name, ".comp.spv")),
-        }
+        Kernel { name: $name, spirv: include_bytes!(concat!("../../spirv/", $name, ".comp.spv")) }
     };
 }
 

@@ -19,46 +19,25 @@ impl GpuTimer {
         let Some(period_ns) = ctx.info().timestamp_period_ns else {
             return Ok(None);
         };
-        let info = vk::QueryPoolCreateInfo::default()
-            .query_type(vk::QueryType::TIMESTAMP)
-            .query_count(2 * pairs);
+        let info = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(2 * pairs);
         let pool = unsafe { ctx.device.create_query_pool(&info, None) }?;
-        Ok(Some(GpuTimer {
-            shared: ctx.shared.clone(),
-            pool,
-            pairs,
-            period_ns,
-        }))
+        Ok(Some(GpuTimer { shared: ctx.shared.clone(), pool, pairs, period_ns }))
     }
 
     /// Resets every pair; record before the first `begin` in a command buffer.
     pub fn reset(&self, cmd: vk::CommandBuffer) {
-        unsafe {
-            self.shared
-                .device
-                .cmd_reset_query_pool(cmd, self.pool, 0, 2 * self.pairs)
-        };
+        unsafe { self.shared.device.cmd_reset_query_pool(cmd, self.pool, 0, 2 * self.pairs) };
     }
 
     pub fn begin(&self, cmd: vk::CommandBuffer, pair: u32) {
         unsafe {
-            self.shared.device.cmd_write_timestamp(
-                cmd,
-                vk::PipelineStageFlags::TOP_OF_PIPE,
-                self.pool,
-                2 * pair,
-            )
+            self.shared.device.cmd_write_timestamp(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, self.pool, 2 * pair)
         };
     }
 
     pub fn end(&self, cmd: vk::CommandBuffer, pair: u32) {
         unsafe {
-            self.shared.device.cmd_write_timestamp(
-                cmd,
-                vk::PipelineStageFlags::BOTTOM_OF_PIPE,
-                self.pool,
-                2 * pair + 1,
-            )
+            self.shared.device.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, self.pool, 2 * pair + 1)
         };
     }
 
@@ -73,10 +52,7 @@ impl GpuTimer {
                 vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
             )
         }?;
-        Ok(ticks
-            .chunks(2)
-            .map(|t| t[1].wrapping_sub(t[0]) as f64 * self.period_ns * 1e-9)
-            .collect())
+        Ok(ticks.chunks(2).map(|t| t[1].wrapping_sub(t[0]) as f64 * self.period_ns * 1e-9).collect())
     }
 }
 

@@ -253,9 +253,7 @@ pub fn check(param: Param, value: Value) -> Result<(), String> {
             if c.iter().all(|&v| in_range(v)) {
                 Ok(())
             } else {
-                Err(format!(
-                    "{param} = {value} is out of range: each channel must be in [0, 1] (linear)"
-                ))
+                Err(format!("{param} = {value} is out of range: each channel must be in [0, 1] (linear)"))
             }
         }
         (false, Value::Scalar(v)) => {
@@ -265,9 +263,7 @@ pub fn check(param: Param, value: Value) -> Result<(), String> {
                 Err(format!("{param} = {v} is out of range [0, {max}]"))
             }
         }
-        (true, Value::Scalar(_)) => {
-            Err(format!("{param} is a colour: give three numbers [r, g, b]"))
-        }
+        (true, Value::Scalar(_)) => Err(format!("{param} is a colour: give three numbers [r, g, b]")),
         (false, Value::Color(_)) => Err(format!("{param} is a number, not a colour")),
     }
 }
@@ -279,11 +275,7 @@ pub fn parse_value(param: Param, text: &str) -> Result<Value, String> {
     let value = match (param.is_color(), numbers.as_slice()) {
         (true, [r, g, b]) => Value::Color([*r, *g, *b]),
         (true, [grey]) => Value::Color([*grey; 3]),
-        (true, _) => {
-            return Err(format!(
-                "{param} takes r,g,b or one grey value, not '{text}'"
-            ))
-        }
+        (true, _) => return Err(format!("{param} takes r,g,b or one grey value, not '{text}'")),
         (false, [v]) => Value::Scalar(*v),
         (false, _) => return Err(format!("{param} takes one number, not '{text}'")),
     };
@@ -314,13 +306,8 @@ mod tests {
         assert!(p.set(Param::Specular, Value::Scalar(2.0)).is_ok());
         assert!(p.set(Param::Specular, Value::Scalar(2.6)).is_err());
         assert!(p.set(Param::BaseColor, Value::Scalar(0.5)).is_err());
-        assert!(p
-            .set(Param::BaseColor, Value::Color([0.5, -0.1, 0.2]))
-            .is_err());
-        assert_eq!(
-            parse_value(Param::BaseColor, "0.9,0.6,0.3"),
-            Ok(Value::Color([0.9, 0.6, 0.3]))
-        );
+        assert!(p.set(Param::BaseColor, Value::Color([0.5, -0.1, 0.2])).is_err());
+        assert_eq!(parse_value(Param::BaseColor, "0.9,0.6,0.3"), Ok(Value::Color([0.9, 0.6, 0.3])));
         assert_eq!(parse_value(Param::Metallic, "1"), Ok(Value::Scalar(1.0)));
         assert!(parse_value(Param::Metallic, "x").is_err());
     }

@@ -17,12 +17,7 @@ pub enum Tonemap {
 }
 
 impl Tonemap {
-    pub const ALL: [Tonemap; 4] = [
-        Tonemap::Linear,
-        Tonemap::Neutral,
-        Tonemap::Aces,
-        Tonemap::Agx,
-    ];
+    pub const ALL: [Tonemap; 4] = [Tonemap::Linear, Tonemap::Neutral, Tonemap::Aces, Tonemap::Agx];
 
     pub fn name(self) -> &'static str {
         match self {

@@ -44,13 +44,8 @@ pub fn gtr1_norm(alpha2: f32) -> f32 {
 pub fn make_lobes(m: &Params) -> Lobes {
     let base_color = Vec3::from(m.base_color);
     let lum = tint_luminance(base_color);
-    let ctint = if lum > 0.0 {
-        base_color / lum
-    } else {
-        Vec3::ONE
-    };
-    let cspec0 =
-        (m.specular * 0.08 * Vec3::ONE.lerp(ctint, m.specular_tint)).lerp(base_color, m.metallic);
+    let ctint = if lum > 0.0 { base_color / lum } else { Vec3::ONE };
+    let cspec0 = (m.specular * 0.08 * Vec3::ONE.lerp(ctint, m.specular_tint)).lerp(base_color, m.metallic);
     let sheen_color = m.sheen * Vec3::ONE.lerp(ctint, m.sheen_tint);
     let aspect = (1.0 - 0.9 * m.anisotropic).sqrt();
     let r2 = m.roughness * m.roughness;

@@ -18,23 +18,14 @@ pub struct LobeChoice {
 /// Picks lobes in proportion to an estimate of their reflectance at this view angle.
 pub fn choose_lobes(s: &Lobes, cos_v: f32) -> LobeChoice {
     let fv = schlick_weight(cos_v);
-    let w_diffuse =
-        (1.0 - s.metallic) * (luminance(s.base_color) + 0.25 * luminance(s.sheen_color));
+    let w_diffuse = (1.0 - s.metallic) * (luminance(s.base_color) + 0.25 * luminance(s.sheen_color));
     let w_specular = luminance(s.cspec0.lerp(Vec3::ONE, fv));
     let w_clearcoat = s.clearcoat * mix(0.04, 1.0, fv);
     let total = w_diffuse + w_specular + w_clearcoat;
     if !(total > 0.0) {
-        return LobeChoice {
-            diffuse: 1.0,
-            specular: 0.0,
-            clearcoat: 0.0,
-        };
+        return LobeChoice { diffuse: 1.0, specular: 0.0, clearcoat: 0.0 };
     }
-    LobeChoice {
-        diffuse: w_diffuse / total,
-        specular: w_specular / total,
-        clearcoat: w_clearcoat / total,
-    }
+    LobeChoice { diffuse: w_diffuse / total, specular: w_specular / total, clearcoat: w_clearcoat / total }
 }
 
 /// Cosine-weighted hemisphere, by Shirley and Chiu's concentric disk mapping.
@@ -78,20 +69,18 @@ pub fn pdf_ggx_reflection(v: Vec3, h: Vec3, ax: f32, ay: f32) -> f32 {
 /// A GTR1 half vector (Burley 2012, appendix B): cos²θh = (1 − α^(2(1−u)))/(1 − α²).
 pub fn sample_gtr1_normal(alpha2: f32, u: Vec2) -> Vec3 {
     let phi = TWO_PI * u.x;
-    let cos2 = if alpha2 >= 1.0 {
-        1.0 - u.y
-    } else {
-        (1.0 - alpha2.powf(1.0 - u.y)) / (1.0 - alpha2)
-    };
+    let cos2 = if alpha2 >= 1.0 { 1.0 - u.y } else { (1.0 - alpha2.powf(1.0 - u.y)) / (1.0 - alpha2) };
     let cos2 = cos2.clamp(0.0, 1.0);
     let sin_theta = (1.0 - cos2).sqrt();
     Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos2.sqrt())
 }
 
-/// pdf of l = reflect(−v, h) for GTR1 half-vector sampling: D(h)·(N·h)/(4·v·h).
+/// pdf of l = reflect(−v, h) for GTR1 half-vector sampling: D(h)·(N·h)/(4·|v·h|), with h taken
+/// in the upper hemisphere (see the GLSL for why).
 pub fn pdf_gtr1_reflection(v: Vec3, h: Vec3, alpha2: f32, norm: f32) -> f32 {
-    let vh = v.dot(h);
-    if h.z > 0.0 && vh > 0.0 {
+    let h = if h.z < 0.0 { -h } else { h };
+    let vh = v.dot(h).abs();
+    if vh > 0.0 {
         gtr1(h, alpha2, norm) * h.z / (4.0 * vh)
     } else {
         0.0

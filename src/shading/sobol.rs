@@ -13,12 +13,7 @@ pub fn hash_u32(mut x: u32) -> u32 {
 }
 
 pub fn hash_combine(seed: u32, value: u32) -> u32 {
-    hash_u32(
-        seed ^ (value
-            .wrapping_add(0x9e3779b9)
-            .wrapping_add(seed << 6)
-            .wrapping_add(seed >> 2)),
-    )
+    hash_u32(seed ^ (value.wrapping_add(0x9e3779b9).wrapping_add(seed << 6).wrapping_add(seed >> 2)))
 }
 
 /// A Laine–Karras style permutation on bit-reversed integers.
@@ -73,9 +68,7 @@ mod tests {
         for k in 1..32 {
             v[k] = v[k - 1] ^ (v[k - 1] >> 1);
         }
-        (0..32)
-            .filter(|&b| index & (1 << b) != 0)
-            .fold(0, |acc, b| acc ^ v[b])
+        (0..32).filter(|&b| index & (1 << b) != 0).fold(0, |acc, b| acc ^ v[b])
     }
 
     #[test]
@@ -106,10 +99,7 @@ mod tests {
                         let cy = (p.y * (1u32 << ky) as f32) as u32;
                         counts[(cy * (1 << kx) + cx) as usize] += 1;
                     }
-                    assert!(
-                        counts.iter().all(|&c| c == 1),
-                        "seed {seed} m {m} kx {kx}: {counts:?}"
-                    );
+                    assert!(counts.iter().all(|&c| c == 1), "seed {seed} m {m} kx {kx}: {counts:?}");
                 }
             }
         }
@@ -120,8 +110,6 @@ mod tests {
         let a: Vec<Vec2> = (0..16).map(|i| sobol_owen_2d(i, 1)).collect();
         let b: Vec<Vec2> = (0..16).map(|i| sobol_owen_2d(i, 2)).collect();
         assert_ne!(a, b);
-        assert!(a
-            .iter()
-            .all(|p| (0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y)));
+        assert!(a.iter().all(|p| (0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y)));
     }
 }

@@ -39,11 +39,7 @@ impl Density {
     }
     fn pdfs(&self, l: [f64; 3], v: [f64; 3]) -> [f64; 3] {
         let h = normalize(add(l, v));
-        [
-            self.cosine_pdf(l),
-            self.reflection_pdf(self.ggx_d(h[2]), h, v),
-            self.reflection_pdf(self.gtr1_d(h[2]), h, v),
-        ]
+        [self.cosine_pdf(l), self.reflection_pdf(self.ggx_d(h[2]), h, v), self.reflection_pdf(self.gtr1_d(h[2]), h, v)]
     }
 }
 
@@ -74,10 +70,8 @@ pub fn directional_albedo(params: &Params, theta_v: f64) -> [f64; 3] {
 pub fn directional_albedo_at(params: &Params, v: [f64; 3]) -> [f64; 3] {
     let lobes = make_lobes(params);
     let a = mix(0.1, 0.001, params.clearcoat_gloss as f64);
-    let density = Density {
-        alpha_ggx: ((lobes.ax as f64) * (lobes.ay as f64)).sqrt(),
-        alpha2_gtr1: (a * a).min(0.999_999),
-    };
+    let density =
+        Density { alpha_ggx: ((lobes.ax as f64) * (lobes.ay as f64)).sqrt(), alpha2_gtr1: (a * a).min(0.999_999) };
     let (n_u, n_phi) = (384usize, 384usize);
     let vf = Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32);
     let mut sum = [0.0f64; 3];

@@ -6,20 +6,12 @@ use lookdev::gpu::{Context, ContextOptions};
 /// than skip, when the layer is missing: validation is part of what they check.
 pub fn context() -> Context {
     let device_name = std::env::var("LOOKDEV_TEST_DEVICE").ok();
-    Context::new(&ContextOptions {
-        device_name,
-        validation: true,
-    })
-    .unwrap_or_else(|e| panic!("{e}"))
+    Context::new(&ContextOptions { device_name, validation: true }).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Drops the context (destroying the device, which reports leaks) and asserts zero errors.
 pub fn finish(ctx: Context) {
     let counter = ctx.validation_counter();
     drop(ctx);
-    assert_eq!(
-        counter.errors(),
-        0,
-        "Vulkan validation reported errors (see stderr)"
-    );
+    assert_eq!(counter.errors(), 0, "Vulkan validation reported errors (see stderr)");
 }

@@ -5,3 +5,4 @@ pub mod albedo;
 pub mod gpu;
 pub mod random;
 pub mod reference;
+pub mod stats;

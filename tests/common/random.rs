@@ -10,10 +10,7 @@ pub struct Random {
 
 impl Random {
     pub fn new(stream: u32) -> Random {
-        Random {
-            state: 0,
-            stream: hash_u32(stream ^ 0x5bd1_e995),
-        }
+        Random { state: 0, stream: hash_u32(stream ^ 0x5bd1_e995) }
     }
 
     pub fn next_u32(&mut self) -> u32 {

@@ -1,0 +1,122 @@
+//! Reading `.exr` and `.hdr` environments, with the checks of LOOKDEV.md §3.
+
+use super::Environment;
+use crate::{Error, Result};
+use std::path::Path;
+
+/// What to tolerate in an environment file.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LoadOptions {
+    /// Accept a map that is not 2:1 (it is still read as equirectangular).
+    pub any_aspect: bool,
+    /// Replace NaN and negative texels with 0 and +Inf with the largest finite value, instead
+    /// of refusing the file.
+    pub clamp_invalid: bool,
+}
+
+/// Reads an environment, choosing the format by extension.
+pub fn load(path: &Path, options: &LoadOptions) -> Result<Environment> {
+    let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let name = path.display().to_string();
+    match extension.as_deref() {
+        Some("exr") => {
+            let bytes = std::fs::read(path)
+                .map_err(|e| Error::input_file(path, format!("cannot read the environment: {e}")))?;
+            from_exr_bytes(&bytes, &name, options)
+        }
+        Some("hdr") => {
+            let bytes = std::fs::read(path)
+                .map_err(|e| Error::input_file(path, format!("cannot read the environment: {e}")))?;
+            from_hdr_bytes(&bytes, &name, options)
+        }
+        _ => Err(Error::input_file(path, "unsupported environment format: use an equirectangular .exr or .hdr")),
+    }
+}
+
+pub fn from_exr_bytes(bytes: &[u8], name: &str, options: &LoadOptions) -> Result<Environment> {
+    let (width, height, texels) = read_exr_texels(bytes, name)?;
+    validate(width, height, texels, name, options)
+}
+
+/// The RGB texels of an EXR (a Y-only file is read as grey), before any checks.
+pub fn read_exr_texels(bytes: &[u8], name: &str) -> Result<(u32, u32, Vec<[f32; 3]>)> {
+    use exr::prelude::{read, ReadChannels, ReadLayers};
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(std::io::Cursor::new(bytes))
+        .map_err(|e| Error::input_file(name, format!("not a readable OpenEXR file ({e})")))?;
+    let layer = &image.layer_data;
+    let (width, height) = (layer.size.width(), layer.size.height());
+    let channels = &layer.channel_data.list;
+    let find = |wanted: &str| {
+        channels.iter().find(|c| {
+            let n = c.name.to_string();
+            n == wanted || n.ends_with(&format!(".{wanted}"))
+        })
+    };
+    let planes: Vec<Vec<f32>> = match (find("R"), find("G"), find("B"), find("Y")) {
+        (Some(r), Some(g), Some(b), _) => [r, g, b].iter().map(|c| c.sample_data.values_as_f32().collect()).collect(),
+        (_, _, _, Some(y)) => {
+            let grey: Vec<f32> = y.sample_data.values_as_f32().collect();
+            vec![grey.clone(), grey.clone(), grey]
+        }
+        _ => {
+            let found: Vec<String> = channels.iter().map(|c| c.name.to_string()).collect();
+            return Err(Error::input_file(
+                name,
+                format!("an environment needs R, G and B channels (or Y); found {}", found.join(", ")),
+            ));
+        }
+    };
+    let texels = (0..width * height).map(|i| [planes[0][i], planes[1][i], planes[2][i]]).collect();
+    Ok((width as u32, height as u32, texels))
+}
+
+pub fn from_hdr_bytes(bytes: &[u8], name: &str, options: &LoadOptions) -> Result<Environment> {
+    let decoded = image::load_from_memory_with_format(bytes, image::ImageFormat::Hdr)
+        .map_err(|e| Error::input_file(name, format!("not a readable Radiance .hdr file ({e})")))?
+        .into_rgb32f();
+    let (width, height) = decoded.dimensions();
+    let texels = decoded.pixels().map(|p| p.0).collect();
+    validate(width, height, texels, name, options)
+}
+
+/// Checks the shape and the texels, fixing them only when the options allow.
+pub fn validate(
+    width: u32,
+    height: u32,
+    mut texels: Vec<[f32; 3]>,
+    name: &str,
+    options: &LoadOptions,
+) -> Result<Environment> {
+    if width == 0 || height == 0 {
+        return Err(Error::input_file(name, "the environment is empty"));
+    }
+    if width != 2 * height && !options.any_aspect {
+        return Err(Error::input_file(
+            name,
+            format!("the environment is {width}x{height}, not 2:1 as an equirectangular map must be (--env-any-aspect reads it anyway)"),
+        ));
+    }
+    let bad = |v: f32| !v.is_finite() || v < 0.0;
+    let count = |pred: &dyn Fn(f32) -> bool| texels.iter().filter(|t| t.iter().any(|&v| pred(v))).count();
+    let (nan, inf, negative) = (count(&|v| v.is_nan()), count(&|v| v.is_infinite()), count(&|v| v < 0.0));
+    if nan + inf + negative > 0 {
+        let summary = format!("{nan} NaN, {inf} infinite and {negative} negative texels");
+        if !options.clamp_invalid {
+            return Err(Error::input_file(name, format!("the environment has {summary} (--env-clamp replaces them)")));
+        }
+        let largest = texels.iter().flatten().copied().filter(|v| v.is_finite()).fold(0.0f32, f32::max);
+        for texel in &mut texels {
+            for v in texel.iter_mut().filter(|v| bad(**v)) {
+                *v = if *v == f32::INFINITY { largest } else { 0.0 };
+            }
+        }
+        crate::warn(format!("{name}: clamped {summary}"));
+    }
+    Ok(Environment { width, height, texels, source: name.to_string() })
+}

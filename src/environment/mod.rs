@@ -1,0 +1,60 @@
+//! Environments: equirectangular radiance maps (LOOKDEV.md §3), their importance-sampling tables,
+//! and their GPU form.
+//!
+//! Convention: row 0 is the zenith (+Y). A unit direction d maps to
+//! `u = 0.5 + atan2(d.x, −d.z)/2π` (wrapped into [0, 1)) and `v = acos(d.y)/π`, so the image
+//! centre is −Z and u = 0.75 is +X. A rotation of `r` degrees turns the environment about +Y:
+//! lookups use `R_y(−r)·d`.
+
+pub mod distribution;
+pub mod gpu;
+pub mod load;
+pub mod sampling;
+
+pub use distribution::Distribution;
+pub use gpu::GpuEnvironment;
+pub use load::LoadOptions;
+
+/// A validated equirectangular radiance map: finite, non-negative, linear Rec.709.
+#[derive(Clone, Debug)]
+pub struct Environment {
+    pub width: u32,
+    pub height: u32,
+    /// RGB radiance, row 0 = zenith.
+    pub texels: Vec<[f32; 3]>,
+    /// Where it came from, for messages: a path, or "built-in studio".
+    pub source: String,
+}
+
+/// The embedded default: studio.exr, CC0 by Greg Zaal (HDRI Haven), 1024×512, DWAB-compressed.
+const STUDIO_EXR: &[u8] = include_bytes!("studio.exr");
+
+impl Environment {
+    /// The built-in studio environment.
+    pub fn studio() -> Environment {
+        let name = "built-in studio";
+        let (width, height, mut texels) =
+            load::read_exr_texels(STUDIO_EXR, name).expect("the embedded studio environment reads");
+        // DWAB is lossy: its ringing leaves three texels of this file a hair below zero. They are
+        // known and harmless, so they are zeroed here rather than reported on every run.
+        for v in texels.iter_mut().flatten() {
+            *v = v.max(0.0);
+        }
+        load::validate(width, height, texels, name, &LoadOptions::default())
+            .expect("the embedded studio environment is valid")
+    }
+
+    /// A constant environment, as used by furnace tests.
+    pub fn uniform(radiance: [f32; 3], width: u32, height: u32) -> Environment {
+        Environment {
+            width,
+            height,
+            texels: vec![radiance; (width * height) as usize],
+            source: format!("uniform {radiance:?}"),
+        }
+    }
+
+    pub fn texel(&self, x: u32, y: u32) -> [f32; 3] {
+        self.texels[(y * self.width + x) as usize]
+    }
+}
