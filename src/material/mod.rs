@@ -1,5 +1,8 @@
 //! Materials: the eleven BRDF parameters, presets, looks and layer stacks.
 
 pub mod params;
+pub mod preset;
+mod toml_input;
 
 pub use params::{Param, Params, Value};
+pub use preset::Preset;
