@@ -1,5 +1,6 @@
 //! Materials: the eleven BRDF parameters, presets, looks and layer stacks.
 
+pub mod library;
 pub mod params;
 pub mod preset;
 mod toml_input;
