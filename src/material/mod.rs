@@ -1,5 +1,11 @@
 //! Materials: the eleven BRDF parameters, presets, looks and layer stacks.
 
+pub mod library;
+pub mod look;
 pub mod params;
+pub mod preset;
+mod toml_input;
 
+pub use look::Look;
 pub use params::{Param, Params, Value};
+pub use preset::Preset;

@@ -1,0 +1,266 @@
+//! Finding the preset a layer names.
+//!
+//! `preset = "..."` in a look layer is resolved like this:
+//!
+//! 1. If it looks like a path (it contains `/` or `\`, or ends with `.toml`), it is a preset file,
+//!    relative to the look file's folder; absolute paths work too.
+//! 2. Otherwise it is a name, looked up as `<folder>/<name>.toml` in each search folder in turn
+//!    (today only the look file's folder), then among the built-in presets.
+//!
+//! The built-in presets are the files in `presets/`, compiled into the binary. A user library
+//! slots in as another search folder after the look's folder ([`Library::with_search_dir`]).
+
+use std::path::{Path, PathBuf};
+
+use super::preset::Preset;
+use super::toml_input::closest;
+
+/// The built-in presets: every file in `presets/`, by name (the file name without `.toml`).
+/// A test fails if this list and the folder disagree.
+pub static BUILTIN: &[(&str, &str)] = &[
+    (
+        "blue-rubber",
+        include_str!("../../presets/blue-rubber.toml"),
+    ),
+    (
+        "brushed-aluminium",
+        include_str!("../../presets/brushed-aluminium.toml"),
+    ),
+    ("car-paint", include_str!("../../presets/car-paint.toml")),
+    ("chrome", include_str!("../../presets/chrome.toml")),
+    ("copper", include_str!("../../presets/copper.toml")),
+    ("gold", include_str!("../../presets/gold.toml")),
+    ("grime", include_str!("../../presets/grime.toml")),
+    (
+        "red-plastic",
+        include_str!("../../presets/red-plastic.toml"),
+    ),
+    ("silver", include_str!("../../presets/silver.toml")),
+    ("velvet", include_str!("../../presets/velvet.toml")),
+    ("wax", include_str!("../../presets/wax.toml")),
+    (
+        "white-ceramic",
+        include_str!("../../presets/white-ceramic.toml"),
+    ),
+];
+
+/// The built-in preset of this name, if there is one.
+pub fn builtin(name: &str) -> Option<Preset> {
+    let (name, text) = BUILTIN.iter().find(|(n, _)| *n == name)?;
+    let file = PathBuf::from(format!("presets/{name}.toml"));
+    // The built-in files are checked by the test suite; failing here is a build defect.
+    Some(Preset::parse(text, &file).expect("built-in presets parse (tested)"))
+}
+
+/// The names of the built-in presets, sorted.
+pub fn builtin_names() -> Vec<&'static str> {
+    let mut names: Vec<&'static str> = BUILTIN.iter().map(|(n, _)| *n).collect();
+    names.sort_unstable();
+    names
+}
+
+/// Whether a layer's `preset` value is a file path rather than a library name.
+pub fn looks_like_path(reference: &str) -> bool {
+    reference.contains('/') || reference.contains('\\') || reference.ends_with(".toml")
+}
+
+/// Where preset references are looked up.
+#[derive(Clone, Debug, Default)]
+pub struct Library {
+    /// The folder relative preset paths start from: the look file's folder.
+    base: PathBuf,
+    /// Folders searched for `<name>.toml`, in order, before the built-ins.
+    search: Vec<PathBuf>,
+}
+
+impl Library {
+    /// Only the built-in presets; relative paths start from the current directory.
+    pub fn builtin_only() -> Library {
+        Library::default()
+    }
+
+    /// The library a look file sees: its own folder first, then the built-ins.
+    pub fn for_look(look_file: &Path) -> Library {
+        let folder = look_file
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
+        Library {
+            base: folder.clone(),
+            search: vec![folder],
+        }
+    }
+
+    /// Adds a folder to search for names after those already present (for a user library).
+    pub fn with_search_dir(mut self, dir: impl Into<PathBuf>) -> Library {
+        self.search.push(dir.into());
+        self
+    }
+
+    /// Finds and loads the preset a layer names. The error is the problem alone, for the
+    /// caller to place at the look's line; for a preset file with errors it carries that file's
+    /// own `FILE:LINE`.
+    pub fn resolve(&self, reference: &str) -> Result<Preset, String> {
+        if looks_like_path(reference) {
+            return load(reference, &self.base.join(reference));
+        }
+        for dir in &self.search {
+            let path = dir.join(format!("{reference}.toml"));
+            if path.is_file() {
+                return load(reference, &path);
+            }
+        }
+        builtin(reference).ok_or_else(|| self.unknown(reference))
+    }
+
+    fn unknown(&self, name: &str) -> String {
+        let names = self.names();
+        let nearest = closest(name, names.iter().map(String::as_str));
+        let shown: Vec<&str> = nearest.into_iter().take(3).collect();
+        format!("no preset named '{name}' (closest: {})", shown.join(", "))
+    }
+
+    /// Every name the library can resolve: `*.toml` files in the search folders and the
+    /// built-ins. Used only to suggest names, so an unreadable folder is simply skipped.
+    fn names(&self) -> Vec<String> {
+        let mut names: Vec<String> = builtin_names().into_iter().map(String::from).collect();
+        for dir in &self.search {
+            // A look given as a bare file name has the empty path as its folder.
+            let dir = if dir.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                dir.as_path()
+            };
+            let Ok(entries) = std::fs::read_dir(dir) else {
+                continue;
+            };
+            for path in entries.flatten().map(|e| e.path()) {
+                if path.extension().is_some_and(|e| e == "toml") {
+                    if let Some(stem) = path.file_stem() {
+                        names.push(stem.to_string_lossy().into_owned());
+                    }
+                }
+            }
+        }
+        names.sort();
+        names.dedup();
+        names
+    }
+}
+
+fn load(reference: &str, path: &Path) -> Result<Preset, String> {
+    Preset::load(path).map_err(|e| format!("preset '{reference}': {e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::params::Param;
+    use std::collections::BTreeSet;
+
+    fn presets_folder() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("presets")
+    }
+
+    #[test]
+    fn builtin_list_matches_the_presets_folder() {
+        let on_disk: BTreeSet<String> = std::fs::read_dir(presets_folder())
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+            .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+            .collect();
+        let listed: BTreeSet<String> = BUILTIN.iter().map(|(n, _)| n.to_string()).collect();
+        assert_eq!(listed, on_disk, "BUILTIN and presets/ disagree");
+        assert_eq!(listed.len(), BUILTIN.len(), "a name is listed twice");
+        for (name, text) in BUILTIN {
+            let file =
+                std::fs::read_to_string(presets_folder().join(format!("{name}.toml"))).unwrap();
+            assert_eq!(*text, file, "BUILTIN '{name}' embeds another file");
+        }
+    }
+
+    #[test]
+    fn every_builtin_parses_in_range_and_is_described() {
+        for name in builtin_names() {
+            let preset = builtin(name).unwrap();
+            assert_eq!(preset.name, name);
+            assert!(
+                preset.description.len() > 40,
+                "{name}: describe what it models and its sources"
+            );
+            assert!(!preset.tags.is_empty(), "{name}: no tags");
+            for param in Param::ALL {
+                assert!(
+                    crate::material::params::check(param, preset.params.get(param)).is_ok(),
+                    "{name}: {param}"
+                );
+            }
+            let m = preset.params.metallic;
+            assert!(
+                m == 0.0 || m == 1.0,
+                "{name}: metallic is {m}; a surface is a metal or it is not"
+            );
+            if m == 0.0 {
+                let [r, g, b] = preset.params.base_color;
+                let luminance = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+                assert!(
+                    (0.02..=0.9).contains(&luminance),
+                    "{name}: implausible albedo {luminance}"
+                );
+            }
+        }
+    }
+
+    /// F0 = ((n−1)² + k²) / ((n+1)² + k²), the normal-incidence reflectance of a conductor.
+    fn f0(n: f64, k: f64) -> f64 {
+        ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k)
+    }
+
+    /// The (n, k) behind each metal's base_color, for R, G and B, as cited in its description.
+    #[test]
+    fn metal_base_colors_are_f0_of_the_cited_complex_ior() {
+        let metals: [(&str, [(f64, f64); 3]); 5] = [
+            // Johnson & Christy 1972 at 659.5 nm and 450.9 nm; the seed's 546.1 nm value for G.
+            ("gold", [(0.14, 3.697), (0.31, 2.34), (1.38, 1.914)]),
+            ("silver", [(0.05, 4.483), (0.05, 3.54), (0.04, 2.657)]),
+            ("copper", [(0.22, 3.747), (0.84, 2.41), (1.24, 2.397)]),
+            // Rakić et al. 1998 Lorentz-Drude model at 650, 546.1 and 450 nm.
+            ("chrome", [(3.535, 4.348), (2.873, 4.222), (2.145, 3.862)]),
+            (
+                "brushed-aluminium",
+                [(1.420, 7.467), (0.949, 6.416), (0.590, 5.311)],
+            ),
+        ];
+        for (name, nk) in metals {
+            let preset = builtin(name).unwrap();
+            assert_eq!(preset.params.metallic, 1.0, "{name}");
+            for (channel, (n, k)) in nk.into_iter().enumerate() {
+                let stored = preset.params.base_color[channel] as f64;
+                assert!(
+                    (stored - f0(n, k)).abs() < 1e-4,
+                    "{name} channel {channel}: {stored} vs {}",
+                    f0(n, k)
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn paths_and_names_are_told_apart() {
+        assert!(looks_like_path("mine/gold.toml"));
+        assert!(looks_like_path("gold.toml"));
+        assert!(looks_like_path("C:\\presets\\gold"));
+        assert!(!looks_like_path("gold"));
+        assert!(!looks_like_path("brushed-aluminium"));
+    }
+
+    #[test]
+    fn unknown_names_suggest_the_closest() {
+        let error = Library::builtin_only().resolve("golld").unwrap_err();
+        assert!(
+            error.starts_with("no preset named 'golld' (closest: gold, "),
+            "{error}"
+        );
+    }
+}

@@ -1,0 +1,506 @@
+//! Looks: what to render. A look file (LOOKDEV.md §3) sets the environment, the render
+//! settings, and one layer stack per object:
+//!
+//! ```toml
+//! [environment]          # optional; default: the embedded studio environment
+//! file = "studio.exr"    # relative to the look file's folder
+//! rotation = 0.0         # degrees about +Y; any finite number
+//! intensity = 1.0        # finite, >= 0
+//! background = true
+//!
+//! [render]               # optional; command-line flags override
+//! spp = 256              # >= 1
+//! seed = 0               # any u32
+//! exposure = 0.0         # stops; any finite number
+//! tonemap = "neutral"    # linear | neutral | aces | agx
+//!
+//! [[object]]             # a layer stack; without `id` it is the default stack (at most one)
+//! id = 1
+//! [[object.layer]]       # bottom layer first; the bottom layer fills
+//! preset = "blue-rubber" # a library name or a path to a preset file (see `library`)
+//! [[object.layer]]
+//! preset = "gold"
+//! mask = "scratches"     # the g-buffer channel mask.scratches; omitted = 1 everywhere
+//! invert = false
+//! opacity = 1.0          # [0, 1]
+//! [object.layer.set]     # per-parameter overrides on top of the preset
+//! roughness = 0.25
+//! ```
+//!
+//! A layer without `preset` starts from the default parameters. The bottom layer fills the
+//! object: its mask, invert and opacity are accepted (and written back) but have no effect, and
+//! loading warns about them. Every error is one line, `FILE:LINE: problem`, naming the key.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use super::library::Library;
+use super::params::{Param, Params, Value};
+use super::toml_input::{self as input, Field, Source};
+use crate::render::tonemap::Tonemap;
+
+/// What to render: environment, render settings and the layer stacks.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Look {
+    /// The file it was read from; `None` for the built-in look.
+    pub file: Option<PathBuf>,
+    /// From `[environment]`.
+    pub environment: EnvironmentSettings,
+    /// From `[render]`.
+    pub render: RenderSettings,
+    /// From `[[object]]`, in file order.
+    pub objects: Vec<ObjectStack>,
+}
+
+/// `[environment]`. `None` means "not set here": the caller's default applies.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct EnvironmentSettings {
+    /// The environment image, already resolved against the look file's folder.
+    pub file: Option<PathBuf>,
+    /// Degrees about +Y.
+    pub rotation: Option<f32>,
+    /// Radiance scale, finite and ≥ 0.
+    pub intensity: Option<f32>,
+    /// Whether background pixels show the environment.
+    pub background: Option<bool>,
+}
+
+/// `[render]`. `None` means "not set here": command-line flags and defaults apply.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RenderSettings {
+    /// Samples per pixel, ≥ 1.
+    pub spp: Option<u32>,
+    pub seed: Option<u32>,
+    /// Exposure in stops.
+    pub exposure: Option<f32>,
+    pub tonemap: Option<Tonemap>,
+}
+
+/// One `[[object]]`: the layer stack for an object id, or the default stack.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectStack {
+    /// `None` is the default stack, used by every object without a stack of its own.
+    pub id: Option<u32>,
+    /// Bottom layer first. Never empty.
+    pub layers: Vec<Layer>,
+}
+
+/// One `[[object.layer]]`: a preset, overrides, and the mask that blends it over the layers
+/// below.
+#[derive(Clone, Debug)]
+pub struct Layer {
+    /// The `preset` value as written in the file.
+    pub preset: Option<String>,
+    /// The preset's values with `[object.layer.set]` applied on top.
+    pub params: Params,
+    /// Which parameters `[object.layer.set]` set, in [`Param::ALL`] order.
+    pub overrides: Vec<Param>,
+    /// The g-buffer channel `mask.<name>`; `None` is 1 everywhere.
+    pub mask: Option<String>,
+    pub invert: bool,
+    /// In [0, 1].
+    pub opacity: f32,
+    /// The 1-based line of this `[[object.layer]]` in the file, for later error messages
+    /// (such as a mask the g-buffer lacks).
+    pub line: usize,
+}
+
+/// Layers are equal when they mean the same. `line` records where one was written, not what
+/// it means, so it is left out: that is what lets `parse(to_toml(look)) == look` hold.
+impl PartialEq for Layer {
+    fn eq(&self, other: &Layer) -> bool {
+        self.preset == other.preset
+            && self.params == other.params
+            && self.overrides == other.overrides
+            && self.mask == other.mask
+            && self.invert == other.invert
+            && self.opacity == other.opacity
+    }
+}
+
+/// The built-in look, shown when `lookdev render` is given none.
+const DEFAULT_LOOK: &str = include_str!("default_look.toml");
+
+impl Look {
+    /// Reads and parses a look file. A missing file is an error naming it.
+    pub fn load(path: &Path) -> crate::Result<Look> {
+        Look::parse(&input::read_text(path)?, path)
+    }
+
+    /// Parses a look file's text. `file` names it in errors, and its folder is where relative
+    /// paths and preset files are looked for.
+    pub fn parse(text: &str, file: &Path) -> crate::Result<Look> {
+        let mut look = parse_with(Source { file, text }, &Library::for_look(file))?;
+        look.file = Some(file.to_path_buf());
+        Ok(look)
+    }
+
+    /// The built-in look: the shader ball (object 1, "ball") in blue rubber with gold through
+    /// `stripes` and grime through `grunge`; the pedestal (object 2) in white ceramic turning
+    /// to copper through `gradient`; red plastic for any other object; 256 samples per pixel.
+    /// Its presets come from the built-ins only, whatever the current directory holds.
+    pub fn builtin_default() -> Look {
+        let src = Source {
+            file: Path::new("<built-in default look>"),
+            text: DEFAULT_LOOK,
+        };
+        // The embedded text is checked by the test suite; failing here is a build defect.
+        parse_with(src, &Library::builtin_only())
+            .expect("the built-in default look parses (tested)")
+    }
+
+    /// The stack for an object id: its own, else the default stack, else `None`.
+    pub fn stack_for(&self, id: u32) -> Option<&ObjectStack> {
+        let own = self.objects.iter().find(|o| o.id == Some(id));
+        own.or_else(|| self.objects.iter().find(|o| o.id.is_none()))
+    }
+
+    /// Applies `--set NAME=VALUE` to every layer of every object, after the look's own values,
+    /// and records it as an override so that [`Look::to_toml`] keeps it. `value` should come
+    /// from `params::parse_value`, which checks it; one of the wrong kind or range is ignored
+    /// with a warning.
+    pub fn set_everywhere(&mut self, param: Param, value: Value) {
+        for layer in self.objects.iter_mut().flat_map(|o| o.layers.iter_mut()) {
+            if let Err(problem) = layer.params.set(param, value) {
+                crate::warn(format!("ignoring --set: {problem}"));
+                return;
+            }
+            if !layer.overrides.contains(&param) {
+                layer.overrides.push(param);
+                layer.overrides.sort();
+            }
+        }
+    }
+
+    /// Every mask name that any layer references, the bottom layers' included, sorted and
+    /// deduplicated.
+    pub fn mask_names(&self) -> Vec<String> {
+        let mut names: Vec<String> = self
+            .objects
+            .iter()
+            .flat_map(|o| &o.layers)
+            .filter_map(|l| l.mask.clone())
+            .collect();
+        names.sort();
+        names.dedup();
+        names
+    }
+
+    /// The look in the §3 format: presets by their written name, overrides by value, the
+    /// environment file relative to the look file's folder. Parsing it back (from the same
+    /// path) gives an equal look.
+    pub fn to_toml(&self) -> String {
+        let mut lines = Vec::new();
+        self.write_environment(&mut lines);
+        self.write_render(&mut lines);
+        for object in &self.objects {
+            object.write(&mut lines);
+        }
+        lines.join("\n")
+    }
+
+    fn write_environment(&self, lines: &mut Vec<String>) {
+        let env = &self.environment;
+        let mut body = Vec::new();
+        if let Some(file) = &env.file {
+            let folder = self
+                .file
+                .as_deref()
+                .and_then(Path::parent)
+                .unwrap_or(Path::new(""));
+            let relative = file.strip_prefix(folder).unwrap_or(file);
+            body.push(format!(
+                "file = {}",
+                input::quoted(&relative.to_string_lossy())
+            ));
+        }
+        push_float(&mut body, "rotation", env.rotation);
+        push_float(&mut body, "intensity", env.intensity);
+        if let Some(background) = env.background {
+            body.push(format!("background = {background}"));
+        }
+        push_section(lines, "[environment]", body);
+    }
+
+    fn write_render(&self, lines: &mut Vec<String>) {
+        let render = &self.render;
+        let mut body = Vec::new();
+        if let Some(spp) = render.spp {
+            body.push(format!("spp = {spp}"));
+        }
+        if let Some(seed) = render.seed {
+            body.push(format!("seed = {seed}"));
+        }
+        push_float(&mut body, "exposure", render.exposure);
+        if let Some(tonemap) = render.tonemap {
+            body.push(format!("tonemap = {}", input::quoted(tonemap.name())));
+        }
+        push_section(lines, "[render]", body);
+    }
+}
+
+impl ObjectStack {
+    fn write(&self, lines: &mut Vec<String>) {
+        lines.push("[[object]]".to_string());
+        if let Some(id) = self.id {
+            lines.push(format!("id = {id}"));
+        }
+        for layer in &self.layers {
+            layer.write(lines);
+        }
+        lines.push(String::new());
+    }
+}
+
+impl Layer {
+    fn write(&self, lines: &mut Vec<String>) {
+        lines.push("[[object.layer]]".to_string());
+        if let Some(preset) = &self.preset {
+            lines.push(format!("preset = {}", input::quoted(preset)));
+        }
+        if let Some(mask) = &self.mask {
+            lines.push(format!("mask = {}", input::quoted(mask)));
+        }
+        if self.invert {
+            lines.push("invert = true".to_string());
+        }
+        if self.opacity != 1.0 {
+            lines.push(format!("opacity = {}", input::float(self.opacity)));
+        }
+        if !self.overrides.is_empty() {
+            lines.push("[object.layer.set]".to_string());
+            for &param in &self.overrides {
+                lines.push(format!(
+                    "{param} = {}",
+                    input::value(self.params.get(param))
+                ));
+            }
+        }
+    }
+}
+
+fn push_float(body: &mut Vec<String>, key: &str, value: Option<f32>) {
+    if let Some(x) = value {
+        body.push(format!("{key} = {}", input::float(x)));
+    }
+}
+
+/// Writes a table only when it has something in it.
+fn push_section(lines: &mut Vec<String>, header: &str, body: Vec<String>) {
+    if !body.is_empty() {
+        lines.push(header.to_string());
+        lines.extend(body);
+        lines.push(String::new());
+    }
+}
+
+// ---- The file as written: structure only. Values are converted by `parse_with`. ----
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a look table")]
+struct LookFile {
+    environment: Option<EnvironmentFile>,
+    render: Option<RenderFile>,
+    #[serde(default)]
+    object: Vec<Field<ObjectFile>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "an [environment] table")]
+struct EnvironmentFile {
+    file: Option<Field>,
+    rotation: Option<Field>,
+    intensity: Option<Field>,
+    background: Option<Field>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a [render] table")]
+struct RenderFile {
+    spp: Option<Field>,
+    seed: Option<Field>,
+    exposure: Option<Field>,
+    tonemap: Option<Field>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "an [[object]] table")]
+struct ObjectFile {
+    id: Option<Field>,
+    #[serde(default)]
+    layer: Vec<Field<LayerFile>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "an [[object.layer]] table")]
+struct LayerFile {
+    preset: Option<Field>,
+    mask: Option<Field>,
+    invert: Option<Field>,
+    opacity: Option<Field>,
+    /// Parameter name to value; names are checked here rather than by serde so that an unknown
+    /// one can be reported as a parameter, with the closest name.
+    set: Option<BTreeMap<Field<String>, Field>>,
+}
+
+fn parse_with(src: Source, library: &Library) -> crate::Result<Look> {
+    let raw: LookFile = src.decode()?;
+    let folder = src.file.parent().unwrap_or(Path::new(""));
+    let look = Look {
+        file: None,
+        environment: environment(&src, raw.environment, folder)?,
+        render: render(&src, raw.render)?,
+        objects: objects(&src, &raw.object, library)?,
+    };
+    warn_about_bottom_layers(&src, &look);
+    Ok(look)
+}
+
+fn environment(
+    src: &Source,
+    raw: Option<EnvironmentFile>,
+    folder: &Path,
+) -> crate::Result<EnvironmentSettings> {
+    let Some(raw) = raw else {
+        return Ok(EnvironmentSettings::default());
+    };
+    Ok(EnvironmentSettings {
+        file: src
+            .read("file", &raw.file, input::text)?
+            .map(|f| folder.join(f)),
+        rotation: src.read("rotation", &raw.rotation, input::number)?,
+        intensity: src.read("intensity", &raw.intensity, non_negative)?,
+        background: src.read("background", &raw.background, input::boolean)?,
+    })
+}
+
+fn render(src: &Source, raw: Option<RenderFile>) -> crate::Result<RenderSettings> {
+    let Some(raw) = raw else {
+        return Ok(RenderSettings::default());
+    };
+    Ok(RenderSettings {
+        spp: src.read("spp", &raw.spp, |k, v| input::unsigned(k, v, 1))?,
+        seed: src.read("seed", &raw.seed, |k, v| input::unsigned(k, v, 0))?,
+        exposure: src.read("exposure", &raw.exposure, input::number)?,
+        tonemap: src.read("tonemap", &raw.tonemap, tonemap)?,
+    })
+}
+
+/// Converts the `[[object]]` tables, checking that ids are unique and that there is at most one
+/// default stack.
+fn objects(
+    src: &Source,
+    raw: &[Field<ObjectFile>],
+    library: &Library,
+) -> crate::Result<Vec<ObjectStack>> {
+    // The line of the first stack seen for each id (None: the default stack).
+    let mut first_line: BTreeMap<Option<u32>, usize> = BTreeMap::new();
+    let mut stacks = Vec::new();
+    for object in raw {
+        let line = src.line(object.span().start);
+        let id = src.read("id", &object.get_ref().id, |k, v| input::unsigned(k, v, 0))?;
+        if let Some(first) = first_line.insert(id, line) {
+            let problem = match id {
+                Some(id) => format!("duplicate object id {id} (first at line {first})"),
+                None => format!(
+                    "a second default stack ([[object]] without id; the first is at line {first})"
+                ),
+            };
+            return Err(src.error(object.span(), problem));
+        }
+        let layers = &object.get_ref().layer;
+        if layers.is_empty() {
+            return Err(src.error(
+                object.span(),
+                "[[object]] has no layers; add at least one [[object.layer]]",
+            ));
+        }
+        let layers = layers
+            .iter()
+            .map(|l| layer(src, l, library))
+            .collect::<crate::Result<_>>()?;
+        stacks.push(ObjectStack { id, layers });
+    }
+    Ok(stacks)
+}
+
+fn layer(src: &Source, raw: &Field<LayerFile>, library: &Library) -> crate::Result<Layer> {
+    let fields = raw.get_ref();
+    let preset = src.read("preset", &fields.preset, input::text)?;
+    let mut params = Params::default();
+    if let (Some(name), Some(field)) = (&preset, &fields.preset) {
+        params = library
+            .resolve(name)
+            .map_err(|problem| src.error(field.span(), problem))?
+            .params;
+    }
+    let mut overrides = Vec::new();
+    for (key, value) in fields.set.iter().flatten() {
+        let param = Param::from_name(key.get_ref())
+            .ok_or_else(|| src.error(key.span(), unknown_param(key.get_ref())))?;
+        input::set_param(&mut params, param, value.get_ref())
+            .map_err(|problem| src.error(value.span(), problem))?;
+        overrides.push(param);
+    }
+    overrides.sort();
+    Ok(Layer {
+        preset,
+        params,
+        overrides,
+        mask: src.read("mask", &fields.mask, input::text)?,
+        invert: src
+            .read("invert", &fields.invert, input::boolean)?
+            .unwrap_or(false),
+        opacity: src
+            .read("opacity", &fields.opacity, unit_interval)?
+            .unwrap_or(1.0),
+        line: src.line(raw.span().start),
+    })
+}
+
+fn unknown_param(name: &str) -> String {
+    let names = Param::ALL.map(Param::name);
+    input::unknown("parameter", name, "in [object.layer.set]", &names)
+}
+
+fn non_negative(key: &str, value: &toml::Value) -> Result<f32, String> {
+    let x = input::number(key, value)?;
+    if x >= 0.0 {
+        Ok(x)
+    } else {
+        Err(format!("{key} = {x} must be ≥ 0"))
+    }
+}
+
+fn unit_interval(key: &str, value: &toml::Value) -> Result<f32, String> {
+    let x = input::number(key, value)?;
+    if (0.0..=1.0).contains(&x) {
+        Ok(x)
+    } else {
+        Err(format!("{key} = {x} is out of range [0, 1]"))
+    }
+}
+
+fn tonemap(key: &str, value: &toml::Value) -> Result<Tonemap, String> {
+    let name = input::text(key, value)?;
+    Tonemap::from_name(&name).ok_or_else(|| {
+        let names = Tonemap::ALL.map(Tonemap::name);
+        input::unknown("tonemap", &name, "", &names)
+    })
+}
+
+/// The bottom layer fills its object, so settings that only weight a layer do nothing there.
+/// They are kept (and written back), but an artist who set them expected something: say so.
+fn warn_about_bottom_layers(src: &Source, look: &Look) {
+    for bottom in look.objects.iter().filter_map(|o| o.layers.first()) {
+        if bottom.mask.is_some() || bottom.invert || bottom.opacity != 1.0 {
+            crate::warn(format!(
+                "{}:{}: the bottom layer fills its object; its mask, invert and opacity have no effect",
+                src.file.display(),
+                bottom.line
+            ));
+        }
+    }
+}
