@@ -42,19 +42,10 @@ fn one_layer(set: &str) -> String {
 
 #[test]
 fn toml_syntax_errors_carry_the_parsers_line() {
-    assert_eq!(
-        error("[render\nspp = 1\n"),
-        "looks/shot.toml:1: TOML syntax error: unclosed table, expected `]`"
-    );
+    assert_eq!(error("[render\nspp = 1\n"), "looks/shot.toml:1: TOML syntax error: unclosed table, expected `]`");
     let message = error("[render]\nspp = 4\nseed = = 3\n");
-    assert!(
-        message.starts_with("looks/shot.toml:3: TOML syntax error: "),
-        "{message}"
-    );
-    assert_eq!(
-        error("[render]\nspp = 1\nspp = 2\n"),
-        "looks/shot.toml:3: duplicate key 'spp'"
-    );
+    assert!(message.starts_with("looks/shot.toml:3: TOML syntax error: "), "{message}");
+    assert_eq!(error("[render]\nspp = 1\nspp = 2\n"), "looks/shot.toml:3: duplicate key 'spp'");
 }
 
 #[test]
@@ -86,33 +77,19 @@ fn unknown_keys_name_the_table_and_the_expected_keys() {
 #[test]
 fn unknown_parameters_suggest_the_closest() {
     let message = error(&one_layer("rougness = 0.2"));
-    assert!(message.starts_with("looks/shot.toml:5: unknown parameter 'rougness' in [object.layer.set] (expected base_color, "));
-    assert!(
-        message.ends_with("; did you mean 'roughness'?"),
-        "{message}"
-    );
+    assert!(message
+        .starts_with("looks/shot.toml:5: unknown parameter 'rougness' in [object.layer.set] (expected base_color, "));
+    assert!(message.ends_with("; did you mean 'roughness'?"), "{message}");
     let message = error(&one_layer("shininess = 0.2"));
     assert!(!message.contains("did you mean"), "{message}");
 }
 
 #[test]
 fn parameter_values_are_checked_for_range_finiteness_and_kind() {
-    assert_eq!(
-        error(&one_layer("roughness = 1.5")),
-        "looks/shot.toml:5: roughness = 1.5 is out of range [0, 1]"
-    );
-    assert_eq!(
-        error(&one_layer("roughness = nan")),
-        "looks/shot.toml:5: roughness = NaN is not a finite number"
-    );
-    assert_eq!(
-        error(&one_layer("specular = inf")),
-        "looks/shot.toml:5: specular = inf is not a finite number"
-    );
-    assert_eq!(
-        error(&one_layer("clearcoat = 4.5")),
-        "looks/shot.toml:5: clearcoat = 4.5 is out of range [0, 4]"
-    );
+    assert_eq!(error(&one_layer("roughness = 1.5")), "looks/shot.toml:5: roughness = 1.5 is out of range [0, 1]");
+    assert_eq!(error(&one_layer("roughness = nan")), "looks/shot.toml:5: roughness = NaN is not a finite number");
+    assert_eq!(error(&one_layer("specular = inf")), "looks/shot.toml:5: specular = inf is not a finite number");
+    assert_eq!(error(&one_layer("clearcoat = 4.5")), "looks/shot.toml:5: clearcoat = 4.5 is out of range [0, 4]");
     assert_eq!(
         error(&one_layer("base_color = 0.5")),
         "looks/shot.toml:5: base_color must be a linear colour [r, g, b], not the number 0.5"
@@ -129,10 +106,7 @@ fn parameter_values_are_checked_for_range_finiteness_and_kind() {
         error(&one_layer("base_color = [0.5, 1.2, 0.5]")),
         "looks/shot.toml:5: base_color = [0.5, 1.2, 0.5] is out of range: each channel must be in [0, 1] (linear)"
     );
-    assert_eq!(
-        error(&one_layer("metallic = [1, 1, 1]")),
-        "looks/shot.toml:5: metallic must be a number, not an array"
-    );
+    assert_eq!(error(&one_layer("metallic = [1, 1, 1]")), "looks/shot.toml:5: metallic must be a number, not an array");
     assert_eq!(
         error(&one_layer("metallic = \"yes\"")),
         "looks/shot.toml:5: metallic must be a number, not the string \"yes\""
@@ -141,46 +115,19 @@ fn parameter_values_are_checked_for_range_finiteness_and_kind() {
 
 #[test]
 fn environment_and_render_values_are_checked() {
-    assert_eq!(
-        error("[environment]\nintensity = -1\n"),
-        "looks/shot.toml:2: intensity = -1 must be ≥ 0"
-    );
-    assert_eq!(
-        error("[environment]\nintensity = inf\n"),
-        "looks/shot.toml:2: intensity = inf is not a finite number"
-    );
-    assert_eq!(
-        error("[environment]\nrotation = nan\n"),
-        "looks/shot.toml:2: rotation = NaN is not a finite number"
-    );
+    assert_eq!(error("[environment]\nintensity = -1\n"), "looks/shot.toml:2: intensity = -1 must be ≥ 0");
+    assert_eq!(error("[environment]\nintensity = inf\n"), "looks/shot.toml:2: intensity = inf is not a finite number");
+    assert_eq!(error("[environment]\nrotation = nan\n"), "looks/shot.toml:2: rotation = NaN is not a finite number");
     assert_eq!(
         error("[environment]\nbackground = 1\n"),
         "looks/shot.toml:2: background must be true or false, not the integer 1"
     );
-    assert_eq!(
-        error("[environment]\nfile = 3\n"),
-        "looks/shot.toml:2: file must be a string, not the integer 3"
-    );
-    assert_eq!(
-        error("[render]\nspp = 0\n"),
-        "looks/shot.toml:2: spp = 0 is out of range [1, 4294967295]"
-    );
-    assert_eq!(
-        error("[render]\nspp = \"4\"\n"),
-        "looks/shot.toml:2: spp must be a whole number, not the string \"4\""
-    );
-    assert_eq!(
-        error("[render]\nspp = 2.5\n"),
-        "looks/shot.toml:2: spp must be a whole number, not the number 2.5"
-    );
-    assert_eq!(
-        error("[render]\nseed = -1\n"),
-        "looks/shot.toml:2: seed = -1 is out of range [0, 4294967295]"
-    );
-    assert_eq!(
-        error("[render]\nexposure = -inf\n"),
-        "looks/shot.toml:2: exposure = -inf is not a finite number"
-    );
+    assert_eq!(error("[environment]\nfile = 3\n"), "looks/shot.toml:2: file must be a string, not the integer 3");
+    assert_eq!(error("[render]\nspp = 0\n"), "looks/shot.toml:2: spp = 0 is out of range [1, 4294967295]");
+    assert_eq!(error("[render]\nspp = \"4\"\n"), "looks/shot.toml:2: spp must be a whole number, not the string \"4\"");
+    assert_eq!(error("[render]\nspp = 2.5\n"), "looks/shot.toml:2: spp must be a whole number, not the number 2.5");
+    assert_eq!(error("[render]\nseed = -1\n"), "looks/shot.toml:2: seed = -1 is out of range [0, 4294967295]");
+    assert_eq!(error("[render]\nexposure = -inf\n"), "looks/shot.toml:2: exposure = -inf is not a finite number");
     assert_eq!(
         error("[render]\nexposure = \"bright\"\n"),
         "looks/shot.toml:2: exposure must be a number, not the string \"bright\""
@@ -197,29 +144,15 @@ fn environment_and_render_values_are_checked() {
 
 #[test]
 fn layer_values_are_checked() {
-    let layer = |line: &str| {
-        format!("[[object]]\n[[object.layer]]\npreset = \"gold\"\n[[object.layer]]\n{line}\n")
-    };
-    assert_eq!(
-        error(&layer("opacity = 1.5")),
-        "looks/shot.toml:5: opacity = 1.5 is out of range [0, 1]"
-    );
-    assert_eq!(
-        error(&layer("opacity = nan")),
-        "looks/shot.toml:5: opacity = NaN is not a finite number"
-    );
+    let layer = |line: &str| format!("[[object]]\n[[object.layer]]\npreset = \"gold\"\n[[object.layer]]\n{line}\n");
+    assert_eq!(error(&layer("opacity = 1.5")), "looks/shot.toml:5: opacity = 1.5 is out of range [0, 1]");
+    assert_eq!(error(&layer("opacity = nan")), "looks/shot.toml:5: opacity = NaN is not a finite number");
     assert_eq!(
         error(&layer("invert = \"yes\"")),
         "looks/shot.toml:5: invert must be true or false, not the string \"yes\""
     );
-    assert_eq!(
-        error(&layer("mask = \"\"")),
-        "looks/shot.toml:5: mask must not be empty"
-    );
-    assert_eq!(
-        error(&layer("preset = 7")),
-        "looks/shot.toml:5: preset must be a string, not the integer 7"
-    );
+    assert_eq!(error(&layer("mask = \"\"")), "looks/shot.toml:5: mask must not be empty");
+    assert_eq!(error(&layer("preset = 7")), "looks/shot.toml:5: preset must be a string, not the integer 7");
 }
 
 #[test]
@@ -229,28 +162,19 @@ fn object_stacks_are_checked() {
         "looks/shot.toml:4: [[object]] has no layers; add at least one [[object.layer]]"
     );
     let twice = "[[object]]\nid = 1\n[[object.layer]]\n\n[[object]]\nid = 1\n[[object.layer]]\n";
-    assert_eq!(
-        error(twice),
-        "looks/shot.toml:5: duplicate object id 1 (first at line 1)"
-    );
+    assert_eq!(error(twice), "looks/shot.toml:5: duplicate object id 1 (first at line 1)");
     let defaults = "[[object]]\n[[object.layer]]\n[[object]]\nid = 2\n[[object.layer]]\n[[object]]\n[[object.layer]]\n";
     assert_eq!(
         error(defaults),
         "looks/shot.toml:6: a second default stack ([[object]] without id; the first is at line 1)"
     );
-    assert_eq!(
-        error("[[object]]\nid = -1\n"),
-        "looks/shot.toml:2: id = -1 is out of range [0, 4294967295]"
-    );
+    assert_eq!(error("[[object]]\nid = -1\n"), "looks/shot.toml:2: id = -1 is out of range [0, 4294967295]");
 }
 
 #[test]
 fn unknown_presets_suggest_the_closest_names() {
     let message = error("[[object]]\n[[object.layer]]\npreset = \"golld\"\n");
-    assert!(
-        message.starts_with("looks/shot.toml:3: no preset named 'golld' (closest: gold, "),
-        "{message}"
-    );
+    assert!(message.starts_with("looks/shot.toml:3: no preset named 'golld' (closest: gold, "), "{message}");
 }
 
 #[test]
@@ -263,10 +187,7 @@ fn a_missing_look_file_is_named() {
 #[test]
 fn a_preset_file_with_errors_is_named_with_its_line() {
     let dir = scratch("bad-preset");
-    write(
-        &dir.join("scuffed.toml"),
-        "name = \"scuffed\"\nmetallic = 1\nroughness = 2\n",
-    );
+    write(&dir.join("scuffed.toml"), "name = \"scuffed\"\nmetallic = 1\nroughness = 2\n");
     let look = dir.join("shot.toml");
     let text = "[[object]]\n[[object.layer]]\npreset = \"scuffed\"\n";
     let e = Look::parse(text, &look).unwrap_err().to_string();
@@ -278,19 +199,10 @@ fn a_preset_file_with_errors_is_named_with_its_line() {
             dir.join("scuffed.toml").display()
         )
     );
-    let e = Look::parse(
-        "[[object]]\n[[object.layer]]\npreset = \"gone.toml\"\n",
-        &look,
-    )
-    .unwrap_err()
-    .to_string();
+    let e = Look::parse("[[object]]\n[[object.layer]]\npreset = \"gone.toml\"\n", &look).unwrap_err().to_string();
     assert_eq!(
         e,
-        format!(
-            "{}:3: preset 'gone.toml': {}: file not found",
-            look.display(),
-            dir.join("gone.toml").display()
-        )
+        format!("{}:3: preset 'gone.toml': {}: file not found", look.display(), dir.join("gone.toml").display())
     );
 }
 
@@ -299,25 +211,15 @@ fn a_preset_file_with_errors_is_named_with_its_line() {
 #[test]
 fn preset_errors_name_the_key_and_line() {
     let file = Path::new("presets/mine.toml");
-    let e = Preset::parse("name = \"mine\"\n\nmetalic = 1\n", file)
-        .unwrap_err()
-        .to_string();
-    assert!(e.starts_with("presets/mine.toml:3: unknown key 'metalic' at the top level (expected name, description, tags, base_color, "));
+    let e = Preset::parse("name = \"mine\"\n\nmetalic = 1\n", file).unwrap_err().to_string();
+    assert!(e.starts_with(
+        "presets/mine.toml:3: unknown key 'metalic' at the top level (expected name, description, tags, base_color, "
+    ));
     assert!(e.ends_with("; did you mean 'metallic'?"), "{e}");
-    let e = Preset::parse("tags = \"metal\"\n", file)
-        .unwrap_err()
-        .to_string();
-    assert_eq!(
-        e,
-        "presets/mine.toml:1: tags must be an array of strings, not the string \"metal\""
-    );
-    let e = Preset::parse("sheen = -0.1\n", file)
-        .unwrap_err()
-        .to_string();
-    assert_eq!(
-        e,
-        "presets/mine.toml:1: sheen = -0.1 is out of range [0, 2]"
-    );
+    let e = Preset::parse("tags = \"metal\"\n", file).unwrap_err().to_string();
+    assert_eq!(e, "presets/mine.toml:1: tags must be an array of strings, not the string \"metal\"");
+    let e = Preset::parse("sheen = -0.1\n", file).unwrap_err().to_string();
+    assert_eq!(e, "presets/mine.toml:1: sheen = -0.1 is out of range [0, 2]");
 }
 
 #[test]
@@ -328,11 +230,8 @@ fn preset_defaults_and_name_from_the_file() {
     assert!(preset.tags.is_empty() && preset.set.is_empty());
     assert_eq!(preset.params, Params::default());
 
-    let preset = Preset::parse(
-        "name = \"Shiny\"\nroughness = 0\nbase_color = [1, 0, 0]\n",
-        Path::new("x.toml"),
-    )
-    .unwrap();
+    let preset =
+        Preset::parse("name = \"Shiny\"\nroughness = 0\nbase_color = [1, 0, 0]\n", Path::new("x.toml")).unwrap();
     assert_eq!(preset.name, "Shiny");
     assert_eq!(preset.set, vec![Param::BaseColor, Param::Roughness]);
     assert_eq!(preset.params.base_color, [1.0, 0.0, 0.0]);
@@ -345,26 +244,16 @@ fn presets_round_trip_through_toml() {
     for name in library::builtin_names() {
         let preset = library::builtin(name).unwrap();
         let text = preset.to_toml();
-        assert_eq!(
-            Preset::parse(&text, Path::new("elsewhere.toml")).unwrap(),
-            preset,
-            "{text}"
-        );
+        assert_eq!(Preset::parse(&text, Path::new("elsewhere.toml")).unwrap(), preset, "{text}");
     }
     let odd = Preset {
         name: "it's \"odd\"".into(),
         description: "back\\slash\nnew line".into(),
         tags: vec![],
-        params: Params {
-            roughness: 0.1,
-            ..Params::default()
-        },
+        params: Params { roughness: 0.1, ..Params::default() },
         set: vec![Param::Roughness],
     };
-    assert_eq!(
-        Preset::parse(&odd.to_toml(), Path::new("odd.toml")).unwrap(),
-        odd
-    );
+    assert_eq!(Preset::parse(&odd.to_toml(), Path::new("odd.toml")).unwrap(), odd);
 }
 
 // ---- Looks ----
@@ -377,27 +266,16 @@ fn unset_values_take_their_defaults() {
     assert_eq!(look.render, Default::default());
     assert!(look.objects.is_empty() && look.mask_names().is_empty());
 
-    let look = Look::parse(
-        "[[object]]\n[[object.layer]]\n\n[[object.layer]]\npreset = \"gold\"\n",
-        Path::new(SHOT),
-    )
-    .unwrap();
+    let look =
+        Look::parse("[[object]]\n[[object.layer]]\n\n[[object.layer]]\npreset = \"gold\"\n", Path::new(SHOT)).unwrap();
     let stack = &look.objects[0];
     assert_eq!(stack.id, None);
-    let [bare, gold] = &stack.layers[..] else {
-        panic!("two layers")
-    };
-    assert_eq!(
-        (bare.preset.as_deref(), bare.params),
-        (None, Params::default())
-    );
+    let [bare, gold] = &stack.layers[..] else { panic!("two layers") };
+    assert_eq!((bare.preset.as_deref(), bare.params), (None, Params::default()));
     assert_eq!(gold.preset.as_deref(), Some("gold"));
     assert_eq!(gold.params, library::builtin("gold").unwrap().params);
     assert!(gold.overrides.is_empty());
-    assert_eq!(
-        (gold.mask.as_deref(), gold.invert, gold.opacity),
-        (None, false, 1.0)
-    );
+    assert_eq!((gold.mask.as_deref(), gold.invert, gold.opacity), (None, false, 1.0));
     assert_eq!((bare.line, gold.line), (2, 4));
 }
 
@@ -430,10 +308,7 @@ roughness = 0.125
 base_color = [1, 0.5, 0]
 "#;
     let look = Look::parse(text, Path::new(SHOT)).unwrap();
-    assert_eq!(
-        look.environment.file.as_deref(),
-        Some(Path::new("looks/../hdri/studio.exr"))
-    );
+    assert_eq!(look.environment.file.as_deref(), Some(Path::new("looks/../hdri/studio.exr")));
     assert_eq!(look.environment.rotation, Some(-30.0));
     assert_eq!(look.environment.intensity, Some(2.5));
     assert_eq!(look.environment.background, Some(false));
@@ -450,19 +325,13 @@ base_color = [1, 0.5, 0]
     assert_eq!(gold.overrides, vec![Param::BaseColor, Param::Roughness]);
     assert_eq!(gold.params.roughness, 0.125);
     assert_eq!(gold.params.base_color, [1.0, 0.5, 0.0]);
-    assert_eq!(
-        gold.params.metallic, 1.0,
-        "the preset's own values stay under the overrides"
-    );
+    assert_eq!(gold.params.metallic, 1.0, "the preset's own values stay under the overrides");
 }
 
 #[test]
 fn looks_round_trip_through_toml() {
     let dir = scratch("round-trip");
-    write(
-        &dir.join("house/blue.toml"),
-        "base_color = [0.1, 0.2, 0.9]\nroughness = 0.3\n",
-    );
+    write(&dir.join("house/blue.toml"), "base_color = [0.1, 0.2, 0.9]\nroughness = 0.3\n");
     let path = dir.join("looks/shot.toml");
     let text = r#"
 [environment]
@@ -510,16 +379,9 @@ fn a_preset_beside_the_look_beats_the_builtin_of_that_name() {
         &dir.join("gold.toml"),
         "name = \"studio gold\"\nbase_color = [0.5, 0.4, 0.1]\nmetallic = 1\nroughness = 0.9\n",
     );
-    let look = Look::parse(
-        "[[object]]\n[[object.layer]]\npreset = \"gold\"\n",
-        &dir.join("shot.toml"),
-    )
-    .unwrap();
+    let look = Look::parse("[[object]]\n[[object.layer]]\npreset = \"gold\"\n", &dir.join("shot.toml")).unwrap();
     let params = look.objects[0].layers[0].params;
-    assert_eq!(
-        (params.roughness, params.base_color),
-        (0.9, [0.5, 0.4, 0.1])
-    );
+    assert_eq!((params.roughness, params.base_color), (0.9, [0.5, 0.4, 0.1]));
 
     // Without the look's folder, the same name is the built-in.
     let builtin = Library::builtin_only().resolve("gold").unwrap();
@@ -531,18 +393,11 @@ fn presets_can_be_given_by_path() {
     let dir = scratch("paths");
     write(&dir.join("shelf/shiny.toml"), "roughness = 0.05\n");
     let look_file = dir.join("shot.toml");
-    let relative = Look::parse(
-        "[[object]]\n[[object.layer]]\npreset = \"shelf/shiny.toml\"\n",
-        &look_file,
-    )
-    .unwrap();
+    let relative = Look::parse("[[object]]\n[[object.layer]]\npreset = \"shelf/shiny.toml\"\n", &look_file).unwrap();
     assert_eq!(relative.objects[0].layers[0].params.roughness, 0.05);
 
     let absolute = dir.join("shelf/shiny.toml");
-    let text = format!(
-        "[[object]]\n[[object.layer]]\npreset = {:?}\n",
-        absolute.to_string_lossy()
-    );
+    let text = format!("[[object]]\n[[object.layer]]\npreset = {:?}\n", absolute.to_string_lossy());
     let look = Look::parse(&text, Path::new("elsewhere/shot.toml")).unwrap();
     assert_eq!(look.objects[0].layers[0].params.roughness, 0.05);
 }
@@ -551,22 +406,14 @@ fn presets_can_be_given_by_path() {
 fn unknown_names_suggest_presets_beside_the_look_too() {
     let dir = scratch("suggest");
     write(&dir.join("goldleaf.toml"), "metallic = 1\n");
-    let e = Look::parse(
-        "[[object]]\n[[object.layer]]\npreset = \"goldlef\"\n",
-        &dir.join("shot.toml"),
-    )
-    .unwrap_err();
+    let e = Look::parse("[[object]]\n[[object.layer]]\npreset = \"goldlef\"\n", &dir.join("shot.toml")).unwrap_err();
     let message = e.to_string();
-    assert!(
-        message.ends_with(":3: no preset named 'goldlef' (closest: goldleaf, gold, copper)"),
-        "{message}"
-    );
+    assert!(message.ends_with(":3: no preset named 'goldlef' (closest: goldleaf, gold, copper)"), "{message}");
 }
 
 #[test]
 fn set_everywhere_overrides_every_layer_and_is_written_back() {
-    let text =
-        "[[object]]\n[[object.layer]]\npreset = \"gold\"\n[[object]]\nid = 1\n[[object.layer]]\n\
+    let text = "[[object]]\n[[object.layer]]\npreset = \"gold\"\n[[object]]\nid = 1\n[[object.layer]]\n\
                 [[object.layer]]\npreset = \"grime\"\n[object.layer.set]\nmetallic = 1\n";
     let mut look = Look::parse(text, Path::new(SHOT)).unwrap();
     look.set_everywhere(Param::Roughness, Value::Scalar(0.33));
@@ -574,15 +421,9 @@ fn set_everywhere_overrides_every_layer_and_is_written_back() {
     for layer in look.objects.iter().flat_map(|o| &o.layers) {
         assert_eq!(layer.params.roughness, 0.33);
         assert_eq!(layer.params.base_color, [0.2, 0.3, 0.4]);
-        assert!(
-            layer.overrides.contains(&Param::Roughness)
-                && layer.overrides.contains(&Param::BaseColor)
-        );
+        assert!(layer.overrides.contains(&Param::Roughness) && layer.overrides.contains(&Param::BaseColor));
     }
-    assert_eq!(
-        look.objects[1].layers[1].overrides,
-        vec![Param::BaseColor, Param::Metallic, Param::Roughness]
-    );
+    assert_eq!(look.objects[1].layers[1].overrides, vec![Param::BaseColor, Param::Metallic, Param::Roughness]);
     assert_eq!(Look::parse(&look.to_toml(), Path::new(SHOT)).unwrap(), look);
 
     // A value that fails the range check changes nothing.
@@ -593,14 +434,12 @@ fn set_everywhere_overrides_every_layer_and_is_written_back() {
 
 #[test]
 fn stacks_are_found_by_id_then_default() {
-    let with_default = "[[object]]\nid = 1\n[[object.layer]]\npreset = \"gold\"\n[[object]]\n[[object.layer]]\npreset = \"wax\"\n";
+    let with_default =
+        "[[object]]\nid = 1\n[[object.layer]]\npreset = \"gold\"\n[[object]]\n[[object.layer]]\npreset = \"wax\"\n";
     let look = Look::parse(with_default, Path::new(SHOT)).unwrap();
     assert_eq!(look.stack_for(1).unwrap().id, Some(1));
     assert_eq!(look.stack_for(0).unwrap().id, None);
-    assert_eq!(
-        look.stack_for(99).unwrap().layers[0].preset.as_deref(),
-        Some("wax")
-    );
+    assert_eq!(look.stack_for(99).unwrap().layers[0].preset.as_deref(), Some("wax"));
 
     let without = "[[object]]\nid = 1\n[[object.layer]]\npreset = \"gold\"\n";
     let look = Look::parse(without, Path::new(SHOT)).unwrap();
@@ -630,10 +469,7 @@ fn the_builtin_default_look_shows_layering_on_the_shader_ball() {
     assert_eq!(presets, ["blue-rubber", "gold", "grime"]);
     assert_eq!(ball[1].mask.as_deref(), Some("stripes"));
     assert_eq!(ball[1].params.roughness, 0.18);
-    assert_eq!(
-        (ball[2].mask.as_deref(), ball[2].opacity),
-        (Some("grunge"), 0.7)
-    );
+    assert_eq!((ball[2].mask.as_deref(), ball[2].opacity), (Some("grunge"), 0.7));
 
     let pedestal = &look.stack_for(2).unwrap().layers;
     assert_eq!(pedestal[0].preset.as_deref(), Some("white-ceramic"));

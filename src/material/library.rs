@@ -18,30 +18,18 @@ use super::toml_input::closest;
 /// The built-in presets: every file in `presets/`, by name (the file name without `.toml`).
 /// A test fails if this list and the folder disagree.
 pub static BUILTIN: &[(&str, &str)] = &[
-    (
-        "blue-rubber",
-        include_str!("../../presets/blue-rubber.toml"),
-    ),
-    (
-        "brushed-aluminium",
-        include_str!("../../presets/brushed-aluminium.toml"),
-    ),
+    ("blue-rubber", include_str!("../../presets/blue-rubber.toml")),
+    ("brushed-aluminium", include_str!("../../presets/brushed-aluminium.toml")),
     ("car-paint", include_str!("../../presets/car-paint.toml")),
     ("chrome", include_str!("../../presets/chrome.toml")),
     ("copper", include_str!("../../presets/copper.toml")),
     ("gold", include_str!("../../presets/gold.toml")),
     ("grime", include_str!("../../presets/grime.toml")),
-    (
-        "red-plastic",
-        include_str!("../../presets/red-plastic.toml"),
-    ),
+    ("red-plastic", include_str!("../../presets/red-plastic.toml")),
     ("silver", include_str!("../../presets/silver.toml")),
     ("velvet", include_str!("../../presets/velvet.toml")),
     ("wax", include_str!("../../presets/wax.toml")),
-    (
-        "white-ceramic",
-        include_str!("../../presets/white-ceramic.toml"),
-    ),
+    ("white-ceramic", include_str!("../../presets/white-ceramic.toml")),
 ];
 
 /// The built-in preset of this name, if there is one.
@@ -81,14 +69,8 @@ impl Library {
 
     /// The library a look file sees: its own folder first, then the built-ins.
     pub fn for_look(look_file: &Path) -> Library {
-        let folder = look_file
-            .parent()
-            .map(Path::to_path_buf)
-            .unwrap_or_default();
-        Library {
-            base: folder.clone(),
-            search: vec![folder],
-        }
+        let folder = look_file.parent().map(Path::to_path_buf).unwrap_or_default();
+        Library { base: folder.clone(), search: vec![folder] }
     }
 
     /// Adds a folder to search for names after those already present (for a user library).
@@ -126,11 +108,7 @@ impl Library {
         let mut names: Vec<String> = builtin_names().into_iter().map(String::from).collect();
         for dir in &self.search {
             // A look given as a bare file name has the empty path as its folder.
-            let dir = if dir.as_os_str().is_empty() {
-                Path::new(".")
-            } else {
-                dir.as_path()
-            };
+            let dir = if dir.as_os_str().is_empty() { Path::new(".") } else { dir.as_path() };
             let Ok(entries) = std::fs::read_dir(dir) else {
                 continue;
             };
@@ -174,8 +152,7 @@ mod tests {
         assert_eq!(listed, on_disk, "BUILTIN and presets/ disagree");
         assert_eq!(listed.len(), BUILTIN.len(), "a name is listed twice");
         for (name, text) in BUILTIN {
-            let file =
-                std::fs::read_to_string(presets_folder().join(format!("{name}.toml"))).unwrap();
+            let file = std::fs::read_to_string(presets_folder().join(format!("{name}.toml"))).unwrap();
             assert_eq!(*text, file, "BUILTIN '{name}' embeds another file");
         }
     }
@@ -185,29 +162,17 @@ mod tests {
         for name in builtin_names() {
             let preset = builtin(name).unwrap();
             assert_eq!(preset.name, name);
-            assert!(
-                preset.description.len() > 40,
-                "{name}: describe what it models and its sources"
-            );
+            assert!(preset.description.len() > 40, "{name}: describe what it models and its sources");
             assert!(!preset.tags.is_empty(), "{name}: no tags");
             for param in Param::ALL {
-                assert!(
-                    crate::material::params::check(param, preset.params.get(param)).is_ok(),
-                    "{name}: {param}"
-                );
+                assert!(crate::material::params::check(param, preset.params.get(param)).is_ok(), "{name}: {param}");
             }
             let m = preset.params.metallic;
-            assert!(
-                m == 0.0 || m == 1.0,
-                "{name}: metallic is {m}; a surface is a metal or it is not"
-            );
+            assert!(m == 0.0 || m == 1.0, "{name}: metallic is {m}; a surface is a metal or it is not");
             if m == 0.0 {
                 let [r, g, b] = preset.params.base_color;
                 let luminance = 0.2126 * r + 0.7152 * g + 0.0722 * b;
-                assert!(
-                    (0.02..=0.9).contains(&luminance),
-                    "{name}: implausible albedo {luminance}"
-                );
+                assert!((0.02..=0.9).contains(&luminance), "{name}: implausible albedo {luminance}");
             }
         }
     }
@@ -227,21 +192,14 @@ mod tests {
             ("copper", [(0.22, 3.747), (0.84, 2.41), (1.24, 2.397)]),
             // Rakić et al. 1998 Lorentz-Drude model at 650, 546.1 and 450 nm.
             ("chrome", [(3.535, 4.348), (2.873, 4.222), (2.145, 3.862)]),
-            (
-                "brushed-aluminium",
-                [(1.420, 7.467), (0.949, 6.416), (0.590, 5.311)],
-            ),
+            ("brushed-aluminium", [(1.420, 7.467), (0.949, 6.416), (0.590, 5.311)]),
         ];
         for (name, nk) in metals {
             let preset = builtin(name).unwrap();
             assert_eq!(preset.params.metallic, 1.0, "{name}");
             for (channel, (n, k)) in nk.into_iter().enumerate() {
                 let stored = preset.params.base_color[channel] as f64;
-                assert!(
-                    (stored - f0(n, k)).abs() < 1e-4,
-                    "{name} channel {channel}: {stored} vs {}",
-                    f0(n, k)
-                );
+                assert!((stored - f0(n, k)).abs() < 1e-4, "{name} channel {channel}: {stored} vs {}", f0(n, k));
             }
         }
     }
@@ -258,9 +216,6 @@ mod tests {
     #[test]
     fn unknown_names_suggest_the_closest() {
         let error = Library::builtin_only().resolve("golld").unwrap_err();
-        assert!(
-            error.starts_with("no preset named 'golld' (closest: gold, "),
-            "{error}"
-        );
+        assert!(error.starts_with("no preset named 'golld' (closest: gold, "), "{error}");
     }
 }

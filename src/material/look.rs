@@ -142,13 +142,9 @@ impl Look {
     /// to copper through `gradient`; red plastic for any other object; 256 samples per pixel.
     /// Its presets come from the built-ins only, whatever the current directory holds.
     pub fn builtin_default() -> Look {
-        let src = Source {
-            file: Path::new("<built-in default look>"),
-            text: DEFAULT_LOOK,
-        };
+        let src = Source { file: Path::new("<built-in default look>"), text: DEFAULT_LOOK };
         // The embedded text is checked by the test suite; failing here is a build defect.
-        parse_with(src, &Library::builtin_only())
-            .expect("the built-in default look parses (tested)")
+        parse_with(src, &Library::builtin_only()).expect("the built-in default look parses (tested)")
     }
 
     /// The stack for an object id: its own, else the default stack, else `None`.
@@ -177,12 +173,8 @@ impl Look {
     /// Every mask name that any layer references, the bottom layers' included, sorted and
     /// deduplicated.
     pub fn mask_names(&self) -> Vec<String> {
-        let mut names: Vec<String> = self
-            .objects
-            .iter()
-            .flat_map(|o| &o.layers)
-            .filter_map(|l| l.mask.clone())
-            .collect();
+        let mut names: Vec<String> =
+            self.objects.iter().flat_map(|o| &o.layers).filter_map(|l| l.mask.clone()).collect();
         names.sort();
         names.dedup();
         names
@@ -205,16 +197,9 @@ impl Look {
         let env = &self.environment;
         let mut body = Vec::new();
         if let Some(file) = &env.file {
-            let folder = self
-                .file
-                .as_deref()
-                .and_then(Path::parent)
-                .unwrap_or(Path::new(""));
+            let folder = self.file.as_deref().and_then(Path::parent).unwrap_or(Path::new(""));
             let relative = file.strip_prefix(folder).unwrap_or(file);
-            body.push(format!(
-                "file = {}",
-                input::quoted(&relative.to_string_lossy())
-            ));
+            body.push(format!("file = {}", input::quoted(&relative.to_string_lossy())));
         }
         push_float(&mut body, "rotation", env.rotation);
         push_float(&mut body, "intensity", env.intensity);
@@ -272,10 +257,7 @@ impl Layer {
         if !self.overrides.is_empty() {
             lines.push("[object.layer.set]".to_string());
             for &param in &self.overrides {
-                lines.push(format!(
-                    "{param} = {}",
-                    input::value(self.params.get(param))
-                ));
+                lines.push(format!("{param} = {}", input::value(self.params.get(param))));
             }
         }
     }
@@ -358,18 +340,12 @@ fn parse_with(src: Source, library: &Library) -> crate::Result<Look> {
     Ok(look)
 }
 
-fn environment(
-    src: &Source,
-    raw: Option<EnvironmentFile>,
-    folder: &Path,
-) -> crate::Result<EnvironmentSettings> {
+fn environment(src: &Source, raw: Option<EnvironmentFile>, folder: &Path) -> crate::Result<EnvironmentSettings> {
     let Some(raw) = raw else {
         return Ok(EnvironmentSettings::default());
     };
     Ok(EnvironmentSettings {
-        file: src
-            .read("file", &raw.file, input::text)?
-            .map(|f| folder.join(f)),
+        file: src.read("file", &raw.file, input::text)?.map(|f| folder.join(f)),
         rotation: src.read("rotation", &raw.rotation, input::number)?,
         intensity: src.read("intensity", &raw.intensity, non_negative)?,
         background: src.read("background", &raw.background, input::boolean)?,
@@ -390,11 +366,7 @@ fn render(src: &Source, raw: Option<RenderFile>) -> crate::Result<RenderSettings
 
 /// Converts the `[[object]]` tables, checking that ids are unique and that there is at most one
 /// default stack.
-fn objects(
-    src: &Source,
-    raw: &[Field<ObjectFile>],
-    library: &Library,
-) -> crate::Result<Vec<ObjectStack>> {
+fn objects(src: &Source, raw: &[Field<ObjectFile>], library: &Library) -> crate::Result<Vec<ObjectStack>> {
     // The line of the first stack seen for each id (None: the default stack).
     let mut first_line: BTreeMap<Option<u32>, usize> = BTreeMap::new();
     let mut stacks = Vec::new();
@@ -404,23 +376,15 @@ fn objects(
         if let Some(first) = first_line.insert(id, line) {
             let problem = match id {
                 Some(id) => format!("duplicate object id {id} (first at line {first})"),
-                None => format!(
-                    "a second default stack ([[object]] without id; the first is at line {first})"
-                ),
+                None => format!("a second default stack ([[object]] without id; the first is at line {first})"),
             };
             return Err(src.error(object.span(), problem));
         }
         let layers = &object.get_ref().layer;
         if layers.is_empty() {
-            return Err(src.error(
-                object.span(),
-                "[[object]] has no layers; add at least one [[object.layer]]",
-            ));
+            return Err(src.error(object.span(), "[[object]] has no layers; add at least one [[object.layer]]"));
         }
-        let layers = layers
-            .iter()
-            .map(|l| layer(src, l, library))
-            .collect::<crate::Result<_>>()?;
+        let layers = layers.iter().map(|l| layer(src, l, library)).collect::<crate::Result<_>>()?;
         stacks.push(ObjectStack { id, layers });
     }
     Ok(stacks)
@@ -431,17 +395,13 @@ fn layer(src: &Source, raw: &Field<LayerFile>, library: &Library) -> crate::Resu
     let preset = src.read("preset", &fields.preset, input::text)?;
     let mut params = Params::default();
     if let (Some(name), Some(field)) = (&preset, &fields.preset) {
-        params = library
-            .resolve(name)
-            .map_err(|problem| src.error(field.span(), problem))?
-            .params;
+        params = library.resolve(name).map_err(|problem| src.error(field.span(), problem))?.params;
     }
     let mut overrides = Vec::new();
     for (key, value) in fields.set.iter().flatten() {
-        let param = Param::from_name(key.get_ref())
-            .ok_or_else(|| src.error(key.span(), unknown_param(key.get_ref())))?;
-        input::set_param(&mut params, param, value.get_ref())
-            .map_err(|problem| src.error(value.span(), problem))?;
+        let param =
+            Param::from_name(key.get_ref()).ok_or_else(|| src.error(key.span(), unknown_param(key.get_ref())))?;
+        input::set_param(&mut params, param, value.get_ref()).map_err(|problem| src.error(value.span(), problem))?;
         overrides.push(param);
     }
     overrides.sort();
@@ -450,12 +410,8 @@ fn layer(src: &Source, raw: &Field<LayerFile>, library: &Library) -> crate::Resu
         params,
         overrides,
         mask: src.read("mask", &fields.mask, input::text)?,
-        invert: src
-            .read("invert", &fields.invert, input::boolean)?
-            .unwrap_or(false),
-        opacity: src
-            .read("opacity", &fields.opacity, unit_interval)?
-            .unwrap_or(1.0),
+        invert: src.read("invert", &fields.invert, input::boolean)?.unwrap_or(false),
+        opacity: src.read("opacity", &fields.opacity, unit_interval)?.unwrap_or(1.0),
         line: src.line(raw.span().start),
     })
 }

@@ -79,20 +79,11 @@ impl Preset {
     pub fn parse(text: &str, file: &Path) -> crate::Result<Preset> {
         let src = Source { file, text };
         let raw: PresetFile = src.decode()?;
-        let default_name = file
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
+        let default_name = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let mut preset = Preset {
-            name: src
-                .read("name", &raw.name, input::text)?
-                .unwrap_or(default_name),
-            description: src
-                .read("description", &raw.description, input::any_text)?
-                .unwrap_or_default(),
-            tags: src
-                .read("tags", &raw.tags, input::text_list)?
-                .unwrap_or_default(),
+            name: src.read("name", &raw.name, input::text)?.unwrap_or(default_name),
+            description: src.read("description", &raw.description, input::any_text)?.unwrap_or_default(),
+            tags: src.read("tags", &raw.tags, input::text_list)?.unwrap_or_default(),
             params: Params::default(),
             set: Vec::new(),
         };
@@ -121,10 +112,7 @@ impl Preset {
         let tags: Vec<String> = self.tags.iter().map(|t| input::quoted(t)).collect();
         lines.push(format!("tags = [{}]", tags.join(", ")));
         for param in Param::ALL.into_iter().filter(|p| self.set.contains(p)) {
-            lines.push(format!(
-                "{param} = {}",
-                input::value(self.params.get(param))
-            ));
+            lines.push(format!("{param} = {}", input::value(self.params.get(param))));
         }
         lines.push(String::new());
         lines.join("\n")

@@ -30,18 +30,12 @@ impl Source<'_> {
     /// The 1-based line on which a byte offset lies.
     pub fn line(&self, offset: usize) -> usize {
         let end = offset.min(self.text.len());
-        1 + self.text.as_bytes()[..end]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count()
+        1 + self.text.as_bytes()[..end].iter().filter(|&&b| b == b'\n').count()
     }
 
     /// A bad-input error at the line where `span` starts: `FILE:LINE: problem`.
     pub fn error(&self, span: Range<usize>, problem: impl Display) -> Error {
-        Error::input_file(
-            format!("{}:{}", self.file.display(), self.line(span.start)),
-            problem,
-        )
+        Error::input_file(format!("{}:{}", self.file.display(), self.line(span.start)), problem)
     }
 
     /// Parses the text and deserialises it into `T`.
@@ -61,10 +55,7 @@ impl Source<'_> {
         field: &Option<Field>,
         convert: impl FnOnce(&str, &toml::Value) -> Result<T, String>,
     ) -> crate::Result<Option<T>> {
-        field
-            .as_ref()
-            .map(|f| convert(key, f.get_ref()).map_err(|problem| self.error(f.span(), problem)))
-            .transpose()
+        field.as_ref().map(|f| convert(key, f.get_ref()).map_err(|problem| self.error(f.span(), problem))).transpose()
     }
 
     fn located(&self, span: Option<Range<usize>>, problem: String) -> Error {
@@ -148,9 +139,7 @@ fn is_table_header(line: &str) -> bool {
     header.starts_with('[')
         && header.ends_with(']')
         && !name.trim().is_empty()
-        && name
-            .chars()
-            .all(|c| c.is_alphanumeric() || "_-. \"'".contains(c))
+        && name.chars().all(|c| c.is_alphanumeric() || "_-. \"'".contains(c))
 }
 
 /// A header line without its trailing comment.
@@ -160,11 +149,7 @@ fn header_text(line: &str) -> &str {
 
 /// Joins a possibly multi-line library message into one line.
 fn one_line(message: &str) -> String {
-    let lines: Vec<&str> = message
-        .lines()
-        .map(str::trim)
-        .filter(|l| !l.is_empty())
-        .collect();
+    let lines: Vec<&str> = message.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
     lines.join("; ")
 }
 
@@ -173,12 +158,7 @@ fn unknown_field(message: &str) -> Option<(String, Vec<String>)> {
     let rest = message.strip_prefix("unknown field `")?;
     let (key, rest) = rest.split_once('`')?;
     // Every other piece between backticks is an expected name.
-    let expected = rest
-        .split('`')
-        .skip(1)
-        .step_by(2)
-        .map(String::from)
-        .collect();
+    let expected = rest.split('`').skip(1).step_by(2).map(String::from).collect();
     Some((key.to_string(), expected))
 }
 
@@ -186,15 +166,8 @@ fn unknown_field(message: &str) -> Option<(String, Vec<String>)> {
 /// when it is near enough to be a typo.
 /// `place` ("in [render]") may be empty.
 pub(crate) fn unknown(noun: &str, key: &str, place: &str, expected: &[&str]) -> String {
-    let place = if place.is_empty() {
-        String::new()
-    } else {
-        format!(" {place}")
-    };
-    let mut message = format!(
-        "unknown {noun} '{key}'{place} (expected {})",
-        expected.join(", ")
-    );
+    let place = if place.is_empty() { String::new() } else { format!(" {place}") };
+    let mut message = format!("unknown {noun} '{key}'{place} (expected {})", expected.join(", "));
     if let Some(near) = near_miss(key, expected) {
         message.push_str(&format!("; did you mean '{near}'?"));
     }
@@ -204,21 +177,12 @@ pub(crate) fn unknown(noun: &str, key: &str, place: &str, expected: &[&str]) -> 
 /// The candidate closest to `name`, if it is within two edits or a third of its length.
 pub(crate) fn near_miss<'a>(name: &str, candidates: &[&'a str]) -> Option<&'a str> {
     let limit = (name.chars().count() / 3).max(2);
-    closest(name, candidates.iter().copied())
-        .into_iter()
-        .next()
-        .filter(|c| levenshtein(name, c) <= limit)
+    closest(name, candidates.iter().copied()).into_iter().next().filter(|c| levenshtein(name, c) <= limit)
 }
 
 /// All candidates, closest to `name` first (ties in alphabetical order).
-pub(crate) fn closest<'a>(
-    name: &str,
-    candidates: impl IntoIterator<Item = &'a str>,
-) -> Vec<&'a str> {
-    let mut ranked: Vec<(usize, &str)> = candidates
-        .into_iter()
-        .map(|c| (levenshtein(name, c), c))
-        .collect();
+pub(crate) fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Vec<&'a str> {
+    let mut ranked: Vec<(usize, &str)> = candidates.into_iter().map(|c| (levenshtein(name, c), c)).collect();
     ranked.sort();
     ranked.dedup();
     ranked.into_iter().map(|(_, c)| c).collect()
@@ -282,10 +246,7 @@ pub(crate) fn number(key: &str, value: &toml::Value) -> Result<f32, String> {
 /// An integer in `min..=u32::MAX`.
 pub(crate) fn unsigned(key: &str, value: &toml::Value, min: u32) -> Result<u32, String> {
     let toml::Value::Integer(i) = value else {
-        return Err(format!(
-            "{key} must be a whole number, not {}",
-            describe(value)
-        ));
+        return Err(format!("{key} must be a whole number, not {}", describe(value)));
     };
     u32::try_from(*i)
         .ok()
@@ -296,10 +257,7 @@ pub(crate) fn unsigned(key: &str, value: &toml::Value, min: u32) -> Result<u32, 
 pub(crate) fn boolean(key: &str, value: &toml::Value) -> Result<bool, String> {
     match value {
         toml::Value::Boolean(b) => Ok(*b),
-        other => Err(format!(
-            "{key} must be true or false, not {}",
-            describe(other)
-        )),
+        other => Err(format!("{key} must be true or false, not {}", describe(other))),
     }
 }
 
@@ -322,24 +280,13 @@ pub(crate) fn any_text(key: &str, value: &toml::Value) -> Result<String, String>
 
 pub(crate) fn text_list(key: &str, value: &toml::Value) -> Result<Vec<String>, String> {
     let toml::Value::Array(items) = value else {
-        return Err(format!(
-            "{key} must be an array of strings, not {}",
-            describe(value)
-        ));
+        return Err(format!("{key} must be an array of strings, not {}", describe(value)));
     };
-    items
-        .iter()
-        .enumerate()
-        .map(|(i, item)| text(&format!("{key}[{i}]"), item))
-        .collect()
+    items.iter().enumerate().map(|(i, item)| text(&format!("{key}[{i}]"), item)).collect()
 }
 
 /// Sets one of the eleven BRDF parameters from a TOML value, checking its kind and range.
-pub(crate) fn set_param(
-    params: &mut Params,
-    param: Param,
-    value: &toml::Value,
-) -> Result<(), String> {
+pub(crate) fn set_param(params: &mut Params, param: Param, value: &toml::Value) -> Result<(), String> {
     let value = if param.is_color() {
         Value::Color(color(param.name(), value)?)
     } else {
@@ -357,14 +304,8 @@ fn color(key: &str, value: &toml::Value) -> Result<[f32; 3], String> {
             }
             Ok(rgb)
         }
-        toml::Value::Array(items) => Err(format!(
-            "{key} needs three numbers [r, g, b], not {}",
-            items.len()
-        )),
-        other => Err(format!(
-            "{key} must be a linear colour [r, g, b], not {}",
-            describe(other)
-        )),
+        toml::Value::Array(items) => Err(format!("{key} needs three numbers [r, g, b], not {}", items.len())),
+        other => Err(format!("{key} must be a linear colour [r, g, b], not {}", describe(other))),
     }
 }
 
@@ -407,20 +348,14 @@ mod tests {
 
     #[test]
     fn near_misses_only_when_near() {
-        assert_eq!(
-            near_miss("rougness", &["roughness", "metallic"]),
-            Some("roughness")
-        );
+        assert_eq!(near_miss("rougness", &["roughness", "metallic"]), Some("roughness"));
         assert_eq!(near_miss("sppp", &["spp", "seed"]), Some("spp"));
         assert_eq!(near_miss("banana", &["spp", "seed"]), None);
     }
 
     #[test]
     fn lines_are_one_based() {
-        let src = Source {
-            file: Path::new("a.toml"),
-            text: "a = 1\nb = 2\n\nc = 3",
-        };
+        let src = Source { file: Path::new("a.toml"), text: "a = 1\nb = 2\n\nc = 3" };
         assert_eq!(src.line(0), 1);
         assert_eq!(src.line(6), 2);
         assert_eq!(src.line(13), 4);
