@@ -4,6 +4,8 @@
 //! [`material`]), uploaded to the GPU ([`gpu`]), relit by compute kernels ([`render`]) and written
 //! out as images.
 
+pub mod atomic_file;
+pub mod cli;
 pub mod environment;
 pub mod error;
 pub mod gpu;

@@ -371,3 +371,19 @@ fn choose_physical_device(
     candidates.sort_by_key(|c| rank(c.2.device_type));
     Ok(candidates.remove(0))
 }
+
+/// The names and kinds of the usable devices, best first (for `lookdev devices`).
+pub fn list_devices(options: &ContextOptions) -> Result<Vec<(String, String)>> {
+    let ctx = Context::new(options)?;
+    let devices = unsafe { ctx.instance.enumerate_physical_devices() }?;
+    let mut out: Vec<(u32, String, String)> = devices
+        .into_iter()
+        .map(|pd| {
+            let props = unsafe { ctx.instance.get_physical_device_properties(pd) };
+            let kind = format!("{:?}", props.device_type).to_lowercase().replace('_', " ");
+            (rank(props.device_type), device_name(&props), kind)
+        })
+        .collect();
+    out.sort_by_key(|d| d.0);
+    Ok(out.into_iter().map(|(_, name, kind)| (name, kind)).collect())
+}

@@ -147,6 +147,26 @@ impl Look {
         parse_with(src, &Library::builtin_only()).expect("the built-in default look parses (tested)")
     }
 
+    /// The look used for a user g-buffer rendered without a look: every object in the default
+    /// material (LOOKDEV.md §3 defaults: grey 0.8 dielectric, roughness 0.5), default settings.
+    pub fn default_material() -> Look {
+        let layer = Layer {
+            preset: None,
+            params: Params::default(),
+            overrides: Vec::new(),
+            mask: None,
+            invert: false,
+            opacity: 1.0,
+            line: 0,
+        };
+        Look {
+            file: None,
+            environment: EnvironmentSettings::default(),
+            render: RenderSettings::default(),
+            objects: vec![ObjectStack { id: None, layers: vec![layer] }],
+        }
+    }
+
     /// The stack for an object id: its own, else the default stack, else `None`.
     pub fn stack_for(&self, id: u32) -> Option<&ObjectStack> {
         let own = self.objects.iter().find(|o| o.id == Some(id));

@@ -3,6 +3,7 @@
 pub mod library;
 pub mod look;
 pub mod params;
+pub mod stack;
 pub mod preset;
 mod toml_input;
 

@@ -1,3 +1,10 @@
 //! Rendering: parameter resolve, progressive relighting, accumulation and display transforms.
 
+pub mod output;
+pub mod progressive;
+pub mod renderer;
+pub mod scene;
+pub mod settings;
 pub mod tonemap;
+
+pub use renderer::{KernelTimes, Lighting, Renderer};

@@ -1,0 +1,86 @@
+//! `lookdev bench`: relighting throughput on the built-in scene with the default look.
+//!
+//! One sample is one environment sample plus one BRDF sample, combined by MIS, for one pixel.
+//! Throughput is reported over all pixels (as image renderers count) and over covered pixels
+//! only (the pixels that actually shade; the background costs one lookup per pixel and pass).
+
+use crate::environment::Environment;
+use crate::gbuffer::GBuffer;
+use crate::material::Look;
+use crate::render::scene::Scene;
+use crate::render::settings::{Overrides, Settings};
+use crate::render::{progressive, Renderer};
+use crate::Result;
+use clap::Args;
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Vulkan device to use: part of its name (lavapipe is "llvmpipe").
+    #[arg(long, value_name = "NAME")]
+    pub device: Option<String>,
+    /// Samples per pixel for the wall-time figure.
+    #[arg(long, default_value_t = 64)]
+    pub spp: u32,
+    /// Single-sample passes timed for the per-pass kernel time (the median is reported).
+    #[arg(long, default_value_t = 8)]
+    pub passes: u32,
+}
+
+const SIZES: [(u32, u32); 2] = [(512, 512), (1920, 1080)];
+
+pub fn run(args: BenchArgs) -> Result<()> {
+    let ctx = super::context(args.device.clone())?;
+    let counter = ctx.validation_counter();
+    let info = ctx.info().clone();
+    println!("device: {} (subgroup size {})", info.name, info.subgroup_size);
+    println!("scene: built-in shader ball, built-in default look, embedded studio environment");
+    println!(
+        "{:>10} {:>9} {:>16} {:>16} {:>14} {:>12}",
+        "size", "coverage", "Msamples/s", "Msamples/s", "kernel/1spp", "wall"
+    );
+    println!("{:>10} {:>9} {:>16} {:>16} {:>14} {:>12}", "", "", "(all pixels)", "(covered)", "(GPU, median)", format!("({} spp)", args.spp));
+    for (width, height) in SIZES {
+        let look = Look::builtin_default();
+        let settings = Settings::resolve(&look, &Overrides::default())?;
+        let scene = Scene::new(
+            GBuffer::shaderball(width, height),
+            "built-in shader ball".into(),
+            look,
+            Environment::studio(),
+            settings,
+        )?;
+        let gbuffer = &scene.gbuffer;
+        let coverage = gbuffer.coverage.iter().filter(|&&a| a > 0.0).count() as f64 / gbuffer.pixel_count() as f64;
+        let mut renderer = Renderer::new(&ctx, gbuffer, &scene.environment)?;
+        renderer.set_stacks(&scene.stacks)?;
+        renderer.set_lighting(scene.settings.lighting);
+
+        // Warm-up, then single-sample passes for the kernel time.
+        renderer.render_samples(1)?;
+        let mut kernel: Vec<f64> = Vec::new();
+        for _ in 0..args.passes {
+            if let Some(t) = renderer.render_samples(1)? {
+                kernel.push(t);
+            }
+        }
+        kernel.sort_by(f64::total_cmp);
+        let kernel_ms = kernel.get(kernel.len() / 2).map(|t| format!("{:.2} ms", t * 1e3)).unwrap_or("n/a".into());
+
+        // Wall time to the target from a fresh accumulation, as `lookdev render` does it.
+        renderer.set_seed(1);
+        let stats = progressive::accumulate(&mut renderer, args.spp, |_| {})?;
+        let samples = gbuffer.pixel_count() as f64 * args.spp as f64;
+        let wall = stats.wall.as_secs_f64();
+        println!(
+            "{:>10} {:>8.1}% {:>16.2} {:>16.2} {:>14} {:>10.3} s",
+            format!("{width}x{height}"),
+            coverage * 100.0,
+            samples / wall / 1e6,
+            samples * coverage / wall / 1e6,
+            kernel_ms,
+            wall
+        );
+    }
+    drop(ctx);
+    super::check_validation(&counter)
+}

@@ -1,0 +1,84 @@
+//! The command line: `lookdev render | gbuffer | bench | devices`.
+
+mod bench;
+mod gbuffer;
+mod progress;
+mod render;
+
+use crate::gpu::ContextOptions;
+use crate::material::params::{parse_value, Param, Value};
+use crate::{Error, Result};
+use clap::{Parser, Subcommand};
+
+/// lookdev: relight stored g-buffers with Disney principled layer stacks under image-based light.
+#[derive(Parser, Debug)]
+#[command(name = "lookdev", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render a g-buffer (the built-in shader ball by default) to a PNG or EXR.
+    Render(render::RenderArgs),
+    /// Write the built-in look-dev g-buffer to an EXR.
+    Gbuffer(gbuffer::GbufferArgs),
+    /// Measure relighting throughput on the built-in scene.
+    Bench(bench::BenchArgs),
+    /// List the Vulkan devices lookdev can use, best first.
+    Devices,
+}
+
+/// Parses the arguments and runs the command; the caller turns the error into an exit code.
+pub fn run(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<()> {
+    let cli = match Cli::try_parse_from(args) {
+        Ok(cli) => cli,
+        Err(e) if matches!(e.kind(), clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion) => {
+            e.exit()
+        }
+        Err(e) => {
+            // clap explains at length; keep the one line that names the problem.
+            let text = e.to_string();
+            let first = text.lines().next().unwrap_or("invalid arguments").trim_start_matches("error: ");
+            return Err(Error::input(format!("{first} (see lookdev --help)")));
+        }
+    };
+    match cli.command {
+        Command::Render(args) => render::run(args),
+        Command::Gbuffer(args) => gbuffer::run(args),
+        Command::Bench(args) => bench::run(args),
+        Command::Devices => list_devices(),
+    }
+}
+
+fn list_devices() -> Result<()> {
+    for (name, kind) in crate::gpu::context::list_devices(&ContextOptions::from_env(None))? {
+        println!("{name} ({kind})");
+    }
+    Ok(())
+}
+
+/// Parses `NAME=VALUE` for `--set`.
+pub fn parse_set(text: &str) -> Result<(Param, Value)> {
+    let (name, value) =
+        text.split_once('=').ok_or_else(|| Error::input(format!("--set {text}: expected NAME=VALUE, e.g. roughness=0.3")))?;
+    let param = Param::from_name(name.trim()).ok_or_else(|| {
+        Error::input(format!("--set {text}: unknown parameter '{name}' (expected {})", Param::all_names()))
+    })?;
+    let value = parse_value(param, value).map_err(|e| Error::input(format!("--set {text}: {e}")))?;
+    Ok((param, value))
+}
+
+/// A Vulkan context for a command, validated when `LOOKDEV_VALIDATION=1`.
+fn context(device: Option<String>) -> Result<crate::gpu::Context> {
+    crate::gpu::Context::new(&ContextOptions::from_env(device))
+}
+
+/// After a command's GPU work is dropped: with validation on, any validation error fails it.
+fn check_validation(counter: &crate::gpu::context::ValidationCounter) -> Result<()> {
+    match counter.errors() {
+        0 => Ok(()),
+        n => Err(Error::gpu(format!("Vulkan validation reported {n} error(s); see above"))),
+    }
+}

@@ -1,0 +1,46 @@
+//! A progress bar on stderr for work that takes more than about a second.
+
+use indicatif::{ProgressBar, ProgressStyle};
+use std::time::{Duration, Instant};
+
+const SHOW_AFTER: Duration = Duration::from_secs(1);
+
+pub struct Progress {
+    total: u64,
+    label: String,
+    quiet: bool,
+    start: Instant,
+    bar: Option<ProgressBar>,
+}
+
+impl Progress {
+    pub fn new(total: u64, label: impl Into<String>, quiet: bool) -> Progress {
+        Progress { total, label: label.into(), quiet, start: Instant::now(), bar: None }
+    }
+
+    /// Reports `done` of `total`; the bar appears once the work has run for a second.
+    pub fn update(&mut self, done: u64) {
+        if self.quiet {
+            return;
+        }
+        if self.bar.is_none() && self.start.elapsed() >= SHOW_AFTER && done < self.total {
+            let bar = ProgressBar::new(self.total);
+            bar.set_style(
+                ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} spp, {elapsed} elapsed, eta {eta}")
+                    .expect("the template is valid")
+                    .progress_chars("=> "),
+            );
+            bar.set_message(self.label.clone());
+            self.bar = Some(bar);
+        }
+        if let Some(bar) = &self.bar {
+            bar.set_position(done);
+        }
+    }
+
+    pub fn finish(self) {
+        if let Some(bar) = self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}

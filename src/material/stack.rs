@@ -1,0 +1,136 @@
+//! Layer stacks in their GPU form: one stack per object id found in the g-buffer, its layers
+//! with their own materials, and the masks they use. `resolve.comp` blends them per pixel; the
+//! CPU [`PackedStacks::resolve_pixel`] mirrors it for tests and for inspecting pixels.
+
+use super::look::Look;
+use super::params::Params;
+use crate::{Error, Result};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// One layer as `resolve.comp` reads it (std430, 80 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuLayer {
+    pub params: [f32; 16],
+    /// Index into [`PackedStacks::masks`], or −1 for none (1 everywhere).
+    pub mask: i32,
+    pub invert: u32,
+    pub opacity: f32,
+    pub pad: u32,
+}
+
+/// One stack as `resolve.comp` reads it: its first layer and how many layers it has.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuStack {
+    pub first_layer: u32,
+    pub layer_count: u32,
+    pub pad: [u32; 2],
+}
+
+/// Every stack the g-buffer's objects need, ready to upload.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PackedStacks {
+    pub stacks: Vec<GpuStack>,
+    pub layers: Vec<GpuLayer>,
+    /// The g-buffer masks the layers use, in the order of the GPU's mask layers.
+    pub masks: Vec<String>,
+    /// Object id → index into `stacks`.
+    pub stack_of_object: BTreeMap<u32, u32>,
+}
+
+impl PackedStacks {
+    /// Packs the look's stacks for the objects in `object_ids`. An object with neither its own
+    /// stack nor a default stack gets the default parameters (and a warning). A mask the look
+    /// names that `available_masks` lacks is an error naming both files and the layer's line.
+    pub fn pack(
+        look: &Look,
+        object_ids: impl IntoIterator<Item = u32>,
+        available_masks: &[String],
+        gbuffer_name: &Path,
+    ) -> Result<PackedStacks> {
+        let look_name = look.file.as_deref().map(|p| p.display().to_string()).unwrap_or_else(|| "built-in look".into());
+        let mut masks: Vec<String> = Vec::new();
+        let mut packed =
+            PackedStacks { stacks: Vec::new(), layers: Vec::new(), masks: Vec::new(), stack_of_object: BTreeMap::new() };
+        let mut unstyled = Vec::new();
+        for id in object_ids {
+            let first_layer = packed.layers.len() as u32;
+            match look.stack_for(id) {
+                Some(stack) => {
+                    for layer in &stack.layers {
+                        let mask = match &layer.mask {
+                            Some(name) if packed.layers.len() as u32 > first_layer => {
+                                if !available_masks.contains(name) {
+                                    return Err(Error::input_file(
+                                        format!("{look_name}:{}", layer.line),
+                                        format!(
+                                            "mask '{name}' is not in the g-buffer {} (it has {})",
+                                            gbuffer_name.display(),
+                                            if available_masks.is_empty() {
+                                                "no masks".to_string()
+                                            } else {
+                                                available_masks.iter().map(|m| format!("mask.{m}")).collect::<Vec<_>>().join(", ")
+                                            }
+                                        ),
+                                    ));
+                                }
+                                let index = masks.iter().position(|m| m == name).unwrap_or_else(|| {
+                                    masks.push(name.clone());
+                                    masks.len() - 1
+                                });
+                                index as i32
+                            }
+                            // The bottom layer fills: its mask has no effect.
+                            _ => -1,
+                        };
+                        packed.layers.push(GpuLayer {
+                            params: layer.params.to_gpu(),
+                            mask,
+                            invert: layer.invert as u32,
+                            opacity: layer.opacity,
+                            pad: 0,
+                        });
+                    }
+                }
+                None => {
+                    unstyled.push(id);
+                    packed.layers.push(GpuLayer {
+                        params: Params::default().to_gpu(),
+                        mask: -1,
+                        invert: 0,
+                        opacity: 1.0,
+                        pad: 0,
+                    });
+                }
+            }
+            let layer_count = packed.layers.len() as u32 - first_layer;
+            packed.stack_of_object.insert(id, packed.stacks.len() as u32);
+            packed.stacks.push(GpuStack { first_layer, layer_count, pad: [0; 2] });
+        }
+        if !unstyled.is_empty() {
+            let ids: Vec<String> = unstyled.iter().map(u32::to_string).collect();
+            crate::warn(format!(
+                "{look_name}: no stack for object id {} and no default stack; they get the default material",
+                ids.join(", ")
+            ));
+        }
+        packed.masks = masks;
+        Ok(packed)
+    }
+
+    /// The blended material of one pixel, as `resolve.comp` computes it; `mask_value(i)` is the
+    /// pixel's value of `masks[i]`.
+    pub fn resolve_pixel(&self, object_id: u32, mask_value: impl Fn(usize) -> f32) -> Params {
+        let stack = self.stacks[self.stack_of_object[&object_id] as usize];
+        let layers = &self.layers[stack.first_layer as usize..(stack.first_layer + stack.layer_count) as usize];
+        let mut params = Params::from_gpu(&layers[0].params);
+        for layer in &layers[1..] {
+            let m = if layer.mask >= 0 { mask_value(layer.mask as usize) } else { 1.0 };
+            let w = (layer.opacity * if layer.invert != 0 { 1.0 - m } else { m }).clamp(0.0, 1.0);
+            params = params.mix(&Params::from_gpu(&layer.params), w);
+        }
+        params
+    }
+}

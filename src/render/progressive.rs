@@ -1,0 +1,46 @@
+//! Progressive accumulation to a target sample count, in dispatches sized to the device's speed.
+
+use super::Renderer;
+use crate::Result;
+use std::time::{Duration, Instant};
+
+/// How long one dispatch should take: long enough to amortise submission, short enough for a
+/// responsive progress bar and far below any driver watchdog.
+const TARGET_DISPATCH: Duration = Duration::from_millis(200);
+
+/// What a progressive render measured.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RenderStats {
+    pub wall: Duration,
+    /// Sum of the relight kernels' GPU time, when the device has timestamps.
+    pub gpu_seconds: Option<f64>,
+    pub dispatches: u32,
+}
+
+/// Accumulates until the renderer holds `spp` samples per pixel, calling `progress(samples)`
+/// after each dispatch. The split into dispatches never changes the result: the kernel adds
+/// samples in index order whatever the split.
+pub fn accumulate(renderer: &mut Renderer, spp: u32, mut progress: impl FnMut(u32)) -> Result<RenderStats> {
+    let start = Instant::now();
+    let mut stats = RenderStats::default();
+    let mut batch = 1u32;
+    while renderer.samples() < spp {
+        let count = batch.min(spp - renderer.samples());
+        let dispatch_start = Instant::now();
+        let gpu = renderer.render_samples(count)?;
+        let elapsed = dispatch_start.elapsed();
+        stats.dispatches += 1;
+        stats.gpu_seconds = match (stats.gpu_seconds, gpu) {
+            (Some(total), Some(t)) => Some(total + t),
+            (None, Some(t)) if stats.dispatches == 1 => Some(t),
+            _ => None,
+        };
+        progress(renderer.samples());
+        // Aim the next dispatch at the target time, growing at most 4x at a time.
+        let per_sample = elapsed.as_secs_f64() / count as f64;
+        let ideal = (TARGET_DISPATCH.as_secs_f64() / per_sample.max(1e-9)) as u32;
+        batch = ideal.clamp(1, batch.saturating_mul(4));
+    }
+    stats.wall = start.elapsed();
+    Ok(stats)
+}

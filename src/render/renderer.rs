@@ -1,0 +1,304 @@
+//! The relighting engine: g-buffer, environment and layer stacks on the GPU; resolve, progressive
+//! relight passes, and display transforms. The CLI, the benchmark and the viewer all drive it.
+
+use crate::environment::{self, Distribution, Environment, GpuEnvironment};
+use crate::gbuffer::GBuffer;
+use crate::gpu::pipeline::group_count;
+use crate::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, GpuTimer, Image};
+use crate::material::stack::PackedStacks;
+use crate::render::tonemap::Tonemap;
+use crate::Result;
+use ash::vk;
+
+/// Workgroup edge of the 2D kernels (`local_size_x/y` in glsl/*.comp).
+const LOCAL_SIZE: u32 = 8;
+
+/// How the environment lights the scene. Any change restarts accumulation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lighting {
+    /// Degrees about +Y.
+    pub rotation_degrees: f32,
+    pub intensity: f32,
+    /// Whether background pixels show the environment.
+    pub background: bool,
+}
+
+impl Default for Lighting {
+    fn default() -> Self {
+        Lighting { rotation_degrees: 0.0, intensity: 1.0, background: true }
+    }
+}
+
+/// `Pass` in relight.comp.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct RelightPush {
+    first_sample: u32,
+    sample_count: u32,
+    seed: u32,
+    show_background: u32,
+    cos_rotation: f32,
+    sin_rotation: f32,
+    intensity: f32,
+    image_width: u32,
+}
+
+/// `Display` in display.comp.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct DisplayPush {
+    inverse_sample_count: f32,
+    exposure_scale: f32,
+    tonemap: u32,
+    straight_alpha: u32,
+}
+
+/// The per-object material inputs on the GPU: which stack each pixel uses, the layers, the masks.
+/// Held only to keep them alive while the resolve set points at them.
+struct GpuStacks {
+    _stack_index: Image,
+    _masks: Image,
+    _stacks: Buffer,
+    _layers: Buffer,
+    _set: DescriptorSet,
+}
+
+/// A relighting session for one g-buffer.
+pub struct Renderer {
+    ctx: Context,
+    pub width: u32,
+    pub height: u32,
+    resolve: ComputePipeline,
+    relight: ComputePipeline,
+    display: ComputePipeline,
+    // Held so the GPU resources that descriptor sets point at stay alive.
+    _surface: Image,
+    resolved: Image,
+    accumulation: Image,
+    display_image: Image,
+    object_ids: Vec<u32>,
+    masks: Vec<(String, Vec<f32>)>,
+    stacks: Option<GpuStacks>,
+    _environment: GpuEnvironment,
+    environment_set: DescriptorSet,
+    relight_set: DescriptorSet,
+    display_set: DescriptorSet,
+    timer: Option<GpuTimer>,
+    lighting: Lighting,
+    seed: u32,
+    samples: u32,
+}
+
+/// GPU time of the kernels a call ran, in seconds (None without timestamp support).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct KernelTimes {
+    pub resolve: Option<f64>,
+    pub relight: Option<f64>,
+}
+
+fn float_image(ctx: &Context, width: u32, height: u32, layers: u32, data: &[[f32; 4]]) -> Result<Image> {
+    let image = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, layers, layers > 1)?;
+    image.upload(ctx, bytemuck::cast_slice(data))?;
+    Ok(image)
+}
+
+impl Renderer {
+    pub fn new(ctx: &Context, gbuffer: &GBuffer, environment: &Environment) -> Result<Renderer> {
+        let (width, height) = (gbuffer.width, gbuffer.height);
+        let image = BindingKind::StorageImage;
+        let buffer = BindingKind::StorageBuffer;
+        let resolve = ComputePipeline::new(ctx, &shaders::RESOLVE, &[&[image, image, buffer, buffer, image]], 0)?;
+        let relight = ComputePipeline::new(
+            ctx,
+            &shaders::RELIGHT,
+            &[&[image, image, image], &environment::gpu::SET_LAYOUT],
+            std::mem::size_of::<RelightPush>() as u32,
+        )?;
+        let display =
+            ComputePipeline::new(ctx, &shaders::DISPLAY, &[&[image, image]], std::mem::size_of::<DisplayPush>() as u32)?;
+
+        let mut surface_data = Vec::with_capacity(3 * gbuffer.pixel_count());
+        surface_data.extend(gbuffer.normal.iter().zip(&gbuffer.coverage).map(|(n, a)| [n[0], n[1], n[2], *a]));
+        surface_data.extend(gbuffer.view.iter().map(|v| [v[0], v[1], v[2], 0.0]));
+        surface_data.extend(gbuffer.tangent.iter().map(|t| [t[0], t[1], t[2], 0.0]));
+        let surface = float_image(ctx, width, height, 3, &surface_data)?;
+        let resolved = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 4, true)?;
+        let accumulation = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 1, false)?;
+        let display_image = Image::new(ctx, vk::Format::R8G8B8A8_UNORM, width, height, 1, false)?;
+
+        let gpu_environment = GpuEnvironment::upload(ctx, environment, &Distribution::build(environment))?;
+        let environment_set = relight.bind(1, &gpu_environment.bindings())?;
+        let relight_set = relight.bind(
+            0,
+            &[Binding::Image(&surface), Binding::Image(&resolved), Binding::Image(&accumulation)],
+        )?;
+        let display_set = display.bind(0, &[Binding::Image(&accumulation), Binding::Image(&display_image)])?;
+        Ok(Renderer {
+            ctx: ctx.clone(),
+            width,
+            height,
+            resolve,
+            relight,
+            display,
+            _surface: surface,
+            resolved,
+            accumulation,
+            display_image,
+            object_ids: gbuffer.object_id.clone(),
+            masks: gbuffer.masks.iter().map(|(k, v)| (k.clone(), v.clone())).collect(),
+            stacks: None,
+            _environment: gpu_environment,
+            environment_set,
+            relight_set,
+            display_set,
+            timer: GpuTimer::new(ctx, 2)?,
+            lighting: Lighting::default(),
+            seed: 0,
+            samples: 0,
+        })
+    }
+
+    /// Samples per pixel accumulated since the last change.
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    pub fn lighting(&self) -> Lighting {
+        self.lighting
+    }
+
+    /// Changes the lighting; accumulation restarts if anything changed.
+    pub fn set_lighting(&mut self, lighting: Lighting) {
+        if lighting != self.lighting {
+            self.lighting = lighting;
+            self.samples = 0;
+        }
+    }
+
+    pub fn set_seed(&mut self, seed: u32) {
+        if seed != self.seed {
+            self.seed = seed;
+            self.samples = 0;
+        }
+    }
+
+    /// Uploads new layer stacks and resolves them into one material per pixel (once per edit,
+    /// not per sample). Accumulation restarts.
+    pub fn set_stacks(&mut self, packed: &PackedStacks) -> Result<KernelTimes> {
+        let ctx = &self.ctx;
+        let (width, height) = (self.width, self.height);
+        let pixels = (width * height) as usize;
+        let index: Vec<u32> = self.object_ids.iter().map(|id| packed.stack_of_object[id]).collect();
+        let stack_index = Image::new(ctx, vk::Format::R32_UINT, width, height, 1, false)?;
+        stack_index.upload(ctx, bytemuck::cast_slice(&index))?;
+        // At least one mask layer, so the binding is always valid.
+        let layers = packed.masks.len().max(1) as u32;
+        let mut mask_data = vec![0.0f32; pixels * layers as usize];
+        for (i, name) in packed.masks.iter().enumerate() {
+            let (_, values) = self.masks.iter().find(|(n, _)| n == name).expect("pack() checked the masks");
+            mask_data[i * pixels..(i + 1) * pixels].copy_from_slice(values);
+        }
+        let masks = Image::new(ctx, vk::Format::R32_SFLOAT, width, height, layers, true)?;
+        masks.upload(ctx, bytemuck::cast_slice(&mask_data))?;
+        let stacks = Buffer::with_data(ctx, bytemuck::cast_slice(&packed.stacks))?;
+        let layer_buffer = Buffer::with_data(ctx, bytemuck::cast_slice(&packed.layers))?;
+        let set = self.resolve.bind(
+            0,
+            &[
+                Binding::Image(&stack_index),
+                Binding::Image(&masks),
+                Binding::Buffer(&stacks),
+                Binding::Buffer(&layer_buffer),
+                Binding::Image(&self.resolved),
+            ],
+        )?;
+        let groups = [group_count(width, LOCAL_SIZE), group_count(height, LOCAL_SIZE), 1];
+        let time = self.timed(|renderer, cmd| renderer.resolve.dispatch(cmd, &[&set], &[], groups))?;
+        self.stacks =
+            Some(GpuStacks { _stack_index: stack_index, _masks: masks, _stacks: stacks, _layers: layer_buffer, _set: set });
+        self.samples = 0;
+        Ok(KernelTimes { resolve: time, relight: None })
+    }
+
+    /// Runs `record` in one submission, bracketed by timestamps when the device has them.
+    fn timed(&self, record: impl FnOnce(&Renderer, vk::CommandBuffer)) -> Result<Option<f64>> {
+        self.ctx.run(|cmd| {
+            if let Some(timer) = &self.timer {
+                timer.reset(cmd);
+                timer.begin(cmd, 0);
+            }
+            record(self, cmd);
+            if let Some(timer) = &self.timer {
+                timer.end(cmd, 0);
+            }
+            Ok(())
+        })?;
+        match &self.timer {
+            Some(timer) => Ok(Some(timer.read(1)?[0])),
+            None => Ok(None),
+        }
+    }
+
+    /// Accumulates `count` more samples per pixel in one dispatch. Returns its GPU time.
+    pub fn render_samples(&mut self, count: u32) -> Result<Option<f64>> {
+        assert!(self.stacks.is_some(), "set_stacks() must run before rendering");
+        let rotation = self.lighting.rotation_degrees.to_radians();
+        let push = RelightPush {
+            first_sample: self.samples,
+            sample_count: count,
+            seed: self.seed,
+            show_background: self.lighting.background as u32,
+            cos_rotation: rotation.cos(),
+            sin_rotation: rotation.sin(),
+            intensity: self.lighting.intensity,
+            image_width: self.width,
+        };
+        let groups = [group_count(self.width, LOCAL_SIZE), group_count(self.height, LOCAL_SIZE), 1];
+        let time = self.timed(|renderer, cmd| {
+            renderer.relight.dispatch(
+                cmd,
+                &[&renderer.relight_set, &renderer.environment_set],
+                bytemuck::bytes_of(&push),
+                groups,
+            )
+        })?;
+        self.samples += count;
+        Ok(time)
+    }
+
+    /// The mean radiance per pixel (rgb) and coverage (a), row 0 at the top.
+    pub fn read_radiance(&self) -> Result<Vec<[f32; 4]>> {
+        let sums: Vec<[f32; 4]> = bytemuck::cast_slice(&self.accumulation.read(&self.ctx)?).to_vec();
+        let scale = 1.0 / self.samples.max(1) as f32;
+        Ok(sums.iter().map(|s| s.map(|v| v * scale)).collect())
+    }
+
+    /// Display pixels: exposure, tone map and sRGB, as RGBA8; straight alpha (the coverage) when
+    /// the background is off, opaque otherwise.
+    pub fn read_display(&self, exposure: f32, tonemap: Tonemap) -> Result<Vec<u8>> {
+        let push = DisplayPush {
+            inverse_sample_count: 1.0 / self.samples.max(1) as f32,
+            exposure_scale: exposure.exp2(),
+            tonemap: tonemap.gpu_id(),
+            straight_alpha: !self.lighting.background as u32,
+        };
+        let groups = [group_count(self.width, LOCAL_SIZE), group_count(self.height, LOCAL_SIZE), 1];
+        let staging = Buffer::staging(&self.ctx, self.display_image.byte_size())?;
+        self.ctx.run(|cmd| {
+            self.display.dispatch(cmd, &[&self.display_set], bytemuck::bytes_of(&push), groups);
+            crate::gpu::context::full_barrier(&self.ctx.device, cmd);
+            self.display_image.record_read(cmd, &staging);
+            Ok(())
+        })?;
+        Ok(staging.bytes()[..self.display_image.byte_size() as usize].to_vec())
+    }
+
+    /// The resolved material per pixel, as four layers of vec4 (for tests and inspection).
+    pub fn read_resolved(&self) -> Result<Vec<[f32; 4]>> {
+        Ok(bytemuck::cast_slice(&self.resolved.read(&self.ctx)?).to_vec())
+    }
+
+    pub fn context(&self) -> &Context {
+        &self.ctx
+    }
+}

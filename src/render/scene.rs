@@ -1,0 +1,66 @@
+//! The inputs of a render, read and validated before any GPU work starts: g-buffer, look (with
+//! its stacks packed for the objects present), environment and settings.
+
+use crate::environment::{self, Environment, LoadOptions};
+use crate::gbuffer::GBuffer;
+use crate::material::stack::PackedStacks;
+use crate::material::{Look, Param, Value};
+use crate::render::settings::{Overrides, Settings};
+use crate::Result;
+use std::path::{Path, PathBuf};
+
+/// Size of the built-in shader ball when no g-buffer is given.
+pub const BUILTIN_SIZE: u32 = 1024;
+
+/// Everything a render reads from files, validated.
+pub struct Scene {
+    pub gbuffer: GBuffer,
+    /// The g-buffer's path, or "built-in shader ball", for messages.
+    pub gbuffer_name: PathBuf,
+    pub look: Look,
+    pub environment: Environment,
+    pub settings: Settings,
+    pub stacks: PackedStacks,
+}
+
+impl Scene {
+    /// Packs the look's stacks for the objects in the g-buffer.
+    pub fn new(gbuffer: GBuffer, gbuffer_name: PathBuf, look: Look, environment: Environment, settings: Settings) -> Result<Scene> {
+        let mut ids: Vec<u32> = gbuffer.object_id.clone();
+        ids.sort_unstable();
+        ids.dedup();
+        let available: Vec<String> = gbuffer.masks.keys().cloned().collect();
+        let stacks = PackedStacks::pack(&look, ids, &available, &gbuffer_name)?;
+        Ok(Scene { gbuffer, gbuffer_name, look, environment, settings, stacks })
+    }
+
+    /// Reads a render's inputs. Without a g-buffer, the built-in shader ball; without a look, the
+    /// built-in default look for the shader ball, or the default material for a user g-buffer.
+    /// `sets` override parameters on every layer; `overrides` the look's settings.
+    pub fn load(
+        gbuffer: Option<&Path>,
+        look: Option<&Path>,
+        sets: &[(Param, Value)],
+        overrides: &Overrides,
+        env_options: &LoadOptions,
+    ) -> Result<Scene> {
+        let mut look = match look {
+            Some(path) => Look::load(path)?,
+            None if gbuffer.is_none() => Look::builtin_default(),
+            None => Look::default_material(),
+        };
+        for (param, value) in sets {
+            look.set_everywhere(*param, *value);
+        }
+        let settings = Settings::resolve(&look, overrides)?;
+        let (gbuffer, gbuffer_name) = match gbuffer {
+            Some(path) => (GBuffer::read(path)?, path.to_path_buf()),
+            None => (GBuffer::shaderball(BUILTIN_SIZE, BUILTIN_SIZE), PathBuf::from("built-in shader ball")),
+        };
+        let environment = match &settings.environment {
+            Some(path) => environment::load::load(path, env_options)?,
+            None => Environment::studio(),
+        };
+        Scene::new(gbuffer, gbuffer_name, look, environment, settings)
+    }
+}

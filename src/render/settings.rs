@@ -1,0 +1,69 @@
+//! Render settings: the look's values, overridden by command-line flags, over the defaults.
+
+use super::tonemap::Tonemap;
+use super::Lighting;
+use crate::material::Look;
+use crate::{Error, Result};
+use std::path::PathBuf;
+
+/// Samples per pixel when neither the look nor a flag says.
+pub const DEFAULT_SPP: u32 = 256;
+
+/// Values given on the command line (or by the viewer); `None` leaves the look's value.
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    pub environment: Option<PathBuf>,
+    pub rotation: Option<f32>,
+    pub intensity: Option<f32>,
+    pub no_background: bool,
+    pub spp: Option<u32>,
+    pub seed: Option<u32>,
+    pub exposure: Option<f32>,
+    pub tonemap: Option<Tonemap>,
+}
+
+/// Everything a render needs besides the g-buffer and the stacks.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// None: the embedded studio environment.
+    pub environment: Option<PathBuf>,
+    pub lighting: Lighting,
+    pub spp: u32,
+    pub seed: u32,
+    pub exposure: f32,
+    pub tonemap: Tonemap,
+}
+
+impl Settings {
+    pub fn resolve(look: &Look, overrides: &Overrides) -> Result<Settings> {
+        let env = &look.environment;
+        let render = &look.render;
+        let spp = overrides.spp.or(render.spp).unwrap_or(DEFAULT_SPP);
+        if spp == 0 {
+            return Err(Error::input("--spp 0: the sample count must be at least 1"));
+        }
+        let finite = |name: &str, v: f32| {
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(Error::input(format!("--{name} {v}: must be a finite number")))
+            }
+        };
+        let intensity = finite("intensity", overrides.intensity.or(env.intensity).unwrap_or(1.0))?;
+        if intensity < 0.0 {
+            return Err(Error::input(format!("--intensity {intensity}: must be at least 0")));
+        }
+        Ok(Settings {
+            environment: overrides.environment.clone().or_else(|| env.file.clone()),
+            lighting: Lighting {
+                rotation_degrees: finite("rotation", overrides.rotation.or(env.rotation).unwrap_or(0.0))?,
+                intensity,
+                background: !overrides.no_background && env.background.unwrap_or(true),
+            },
+            spp,
+            seed: overrides.seed.or(render.seed).unwrap_or(0),
+            exposure: finite("exposure", overrides.exposure.or(render.exposure).unwrap_or(0.0))?,
+            tonemap: overrides.tonemap.or(render.tonemap).unwrap_or_default(),
+        })
+    }
+}
