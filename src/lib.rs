@@ -5,6 +5,7 @@
 //! out as images.
 
 pub mod error;
+pub mod gbuffer;
 pub mod material;
 pub mod render;
 
