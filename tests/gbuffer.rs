@@ -842,3 +842,164 @@ fn object_names_come_from_header_attributes() {
         .iter()
         .any(|w| w.contains("objectName.3") && w.contains("not a text")));
 }
+
+// ---------------------------------------------------------------------------------------------
+// The shader ball
+
+const SIZE: u32 = 255; // odd, so one pixel sits on the optical axis
+
+fn shaderball() -> GBuffer {
+    GBuffer::shaderball(SIZE, SIZE)
+}
+
+#[test]
+fn shaderball_fills_the_frame_with_two_named_objects() {
+    let g = shaderball();
+    let n = g.pixel_count() as f32;
+    let coverage: f32 = g.coverage.iter().sum::<f32>() / n;
+    assert!(coverage > 0.4 && coverage < 0.6, "coverage {coverage}");
+    let count = |id| g.object_id.iter().filter(|&&i| i == id).count() as f32 / n;
+    assert!(count(1) > 0.3, "ball {}", count(1));
+    assert!(count(2) > 0.03, "pedestal {}", count(2));
+    assert_eq!(g.object_names.get(&1).map(String::as_str), Some("ball"));
+    assert_eq!(g.object_names.get(&2).map(String::as_str), Some("pedestal"));
+    assert!(g.has_view && g.has_tangent);
+    for i in 0..g.pixel_count() {
+        // Background is object 0; every covered pixel belongs to an object.
+        assert_eq!(g.coverage[i] == 0.0, g.object_id[i] == 0, "pixel {i}");
+    }
+}
+
+#[test]
+fn shaderball_directions_are_unit_and_tangents_orthogonal() {
+    let g = shaderball();
+    for i in 0..g.pixel_count() {
+        let (n, t, v) = (g.normal[i], g.tangent[i], g.view[i]);
+        assert!((length(n) - 1.0).abs() < 1e-5, "N at {i}");
+        assert!((length(t) - 1.0).abs() < 1e-5, "T at {i}");
+        assert!((length(v) - 1.0).abs() < 1e-5, "V at {i}");
+        assert!(dot(n, t).abs() < 1e-5, "T.N at {i}");
+        if g.coverage[i] == 1.0 {
+            assert!(dot(n, v) > -1e-3, "back-facing normal at {i}");
+        }
+    }
+}
+
+#[test]
+fn shaderball_masks_are_bounded_and_non_trivial() {
+    let g = shaderball();
+    assert_eq!(
+        g.masks.keys().collect::<Vec<_>>(),
+        ["gradient", "grunge", "stripes"]
+    );
+    for (name, mask) in &g.masks {
+        let covered: Vec<f32> = mask
+            .iter()
+            .zip(&g.coverage)
+            .filter(|(_, &a)| a > 0.0)
+            .map(|(&m, _)| m)
+            .collect();
+        assert!(
+            mask.iter().all(|m| (0.0..=1.0).contains(m)),
+            "{name} out of [0,1]"
+        );
+        let low = covered.iter().filter(|&&m| m < 0.05).count();
+        let high = covered.iter().filter(|&&m| m > 0.95).count();
+        assert!(low > 20 && high > 20, "{name}: {low} low, {high} high");
+        // Antialiased: plenty of values in between, not a binary pattern.
+        let between = covered.iter().filter(|&&m| m > 0.1 && m < 0.9).count();
+        assert!(between > 50, "{name}: {between} in-between values");
+    }
+}
+
+#[test]
+fn shaderball_masks_have_no_hard_steps() {
+    // Antialiased at any resolution: between neighbouring covered pixels of the ball a mask
+    // never steps straight from "off" to "on"; every edge passes through intermediate values.
+    // (Not the pedestal: at small sizes its top is a pixel tall, and one pixel there spans
+    // surfaces far apart in the world, so a step is the right answer.)
+    for size in [97, SIZE, 600] {
+        let g = GBuffer::shaderball(size, size);
+        let width = size as usize;
+        for (name, mask) in &g.masks {
+            let mut steps = Vec::new();
+            for i in 0..g.pixel_count() {
+                for j in [i + 1, i + width] {
+                    let inside =
+                        j < g.pixel_count() && g.coverage[i] == 1.0 && g.coverage[j] == 1.0;
+                    let ball = inside && g.object_id[i] == 1 && g.object_id[j] == 1;
+                    if ball && (mask[i] - mask[j]).abs() > 0.9 {
+                        steps.push((i % width, i / width));
+                    }
+                }
+            }
+            assert!(
+                steps.is_empty(),
+                "{name} at {size}x{size} has hard steps at {steps:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn shaderball_has_antialiased_silhouettes() {
+    let g = shaderball();
+    let fractional = g.coverage.iter().filter(|&&a| a > 0.0 && a < 1.0).count();
+    // Roughly the perimeter of the ball and pedestal, in pixels.
+    assert!(fractional > 300, "{fractional} fractional pixels");
+    assert!(g.coverage.iter().all(|a| (0.0..=1.0).contains(a)));
+}
+
+#[test]
+fn shaderball_centre_looks_down_minus_z_at_the_ball_head_on() {
+    let g = shaderball();
+    let centre = (SIZE as usize / 2) * SIZE as usize + SIZE as usize / 2;
+    assert_eq!(g.object_id[centre], 1);
+    assert_eq!(g.coverage[centre], 1.0);
+    assert_close(g.normal[centre], [0.0, 0.0, 1.0], 1e-3, "centre N");
+    assert_close(g.tangent[centre], [1.0, 0.0, 0.0], 1e-3, "centre T");
+    // The eye looks along −V: at the centre that is −Z.
+    assert_close(g.view[centre], [0.0, 0.0, 1.0], 1e-4, "centre V");
+}
+
+#[test]
+fn shaderball_background_view_is_the_reversed_camera_ray() {
+    let g = shaderball();
+    let tan_half = (15.0f32).to_radians().tan();
+    for (x, y) in [
+        (0usize, 0usize),
+        (SIZE as usize - 1, 3),
+        (10, SIZE as usize / 2),
+    ] {
+        let i = y * SIZE as usize + x;
+        assert_eq!(g.coverage[i], 0.0);
+        let ndc_x = (x as f32 + 0.5) / SIZE as f32 * 2.0 - 1.0;
+        let ndc_y = 1.0 - (y as f32 + 0.5) / SIZE as f32 * 2.0;
+        let ray = unit([ndc_x * tan_half, ndc_y * tan_half, -1.0]);
+        assert_close(
+            g.view[i],
+            ray.map(|c| -c),
+            1e-4,
+            &format!("background V at ({x}, {y})"),
+        );
+    }
+}
+
+#[test]
+fn shaderball_keeps_the_ball_round_at_any_aspect() {
+    // A wide frame: the horizontal field of view grows, the ball stays a circle in the middle.
+    let g = GBuffer::shaderball(300, 150);
+    let ball = |x: usize, y: usize| g.object_id[y * 300 + x] == 1 && g.coverage[y * 300 + x] > 0.5;
+    let row_width = (0..300).filter(|&x| ball(x, 75)).count();
+    let column_height = (0..150).filter(|&y| ball(150, y)).count();
+    assert!(
+        (row_width as i32 - column_height as i32).abs() <= 2,
+        "{row_width} vs {column_height}"
+    );
+    assert!(ball(150, 75) && !ball(5, 75) && !ball(294, 75));
+}
+
+#[test]
+fn shaderball_is_deterministic() {
+    assert_eq!(GBuffer::shaderball(97, 61), GBuffer::shaderball(97, 61));
+}

@@ -44,6 +44,12 @@ pub(crate) fn orthogonalize(n: Vec3, t: Vec3) -> Option<Vec3> {
     Some(perpendicular / perpendicular_length)
 }
 
+/// The tangent to store for the unit normal `n`: `t` made perpendicular to `n`, falling back on
+/// the stable frame where `t` is unusable. Always unit and orthogonal to `n`.
+pub(crate) fn tangent_or_stable(n: Vec3, t: Vec3) -> Vec3 {
+    orthogonalize(n, t).unwrap_or_else(|| Vec3::from(stable_tangent(n.to_array())))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -98,5 +104,6 @@ mod tests {
         assert_eq!(orthogonalize(n, Vec3::new(0.001, 0.0, 1.0)), None);
         let t = orthogonalize(n, Vec3::new(2.0, 0.0, 2.0)).unwrap();
         assert!((t - Vec3::X).length() < 1e-6);
+        assert_eq!(tangent_or_stable(n, Vec3::ZERO), Vec3::X);
     }
 }

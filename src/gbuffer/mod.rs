@@ -49,7 +49,10 @@
 
 
 mod frame;
+mod procedural;
 mod read;
+mod scene;
+mod shaderball;
 mod validate;
 
 pub use frame::stable_tangent;
