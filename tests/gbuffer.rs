@@ -204,6 +204,13 @@ fn assert_close(a: [f32; 3], b: [f32; 3], tolerance: f32, what: &str) {
     assert!(distance <= tolerance, "{what}: {a:?} vs {b:?}");
 }
 
+fn assert_vectors_close(a: &[[f32; 3]], b: &[[f32; 3]], tolerance: f32, what: &str) {
+    assert_eq!(a.len(), b.len(), "{what}: lengths");
+    for (i, (a, b)) in a.iter().zip(b).enumerate() {
+        assert_close(*a, *b, tolerance, &format!("{what} at pixel {i}"));
+    }
+}
+
 fn length(v: [f32; 3]) -> f32 {
     v.iter().map(|c| c * c).sum::<f32>().sqrt()
 }
@@ -841,6 +848,102 @@ fn object_names_come_from_header_attributes() {
     assert!(warnings
         .iter()
         .any(|w| w.contains("objectName.3") && w.contains("not a text")));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writing
+
+#[test]
+fn write_then_read_reproduces_the_shaderball() {
+    let original = GBuffer::shaderball(64, 48);
+    let path = scratch("round-trip.exr");
+    original.write(&path).unwrap();
+    let (g, warnings) = read_ok(&path);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!((g.width, g.height), (64, 48));
+    // Float channels come back exactly; reading renormalises, which may move the last bit.
+    assert_vectors_close(&g.normal, &original.normal, 1e-6, "N");
+    assert_vectors_close(&g.view, &original.view, 1e-6, "V");
+    assert_vectors_close(&g.tangent, &original.tangent, 1e-6, "T");
+    assert_eq!(g.object_id, original.object_id);
+    assert_eq!(g.object_names, original.object_names);
+    assert_eq!((g.has_view, g.has_tangent), (true, true));
+    // A and masks are stored as half: 11 significant bits.
+    let close = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 5e-4);
+    assert!(close(&g.coverage, &original.coverage));
+    assert_eq!(
+        g.masks.keys().collect::<Vec<_>>(),
+        original.masks.keys().collect::<Vec<_>>()
+    );
+    for (name, mask) in &original.masks {
+        assert!(close(&g.masks[name], mask), "mask {name}");
+    }
+    let meta = MetaData::read_from_file(&path, false).unwrap();
+    assert_eq!(meta.headers.len(), 1);
+    assert_eq!(meta.headers[0].compression, Compression::ZIP16);
+}
+
+#[test]
+fn write_leaves_out_view_and_tangent_when_absent_and_replaces_atomically() {
+    let disc = Disc::new(8, 8);
+    let source = scratch("minimal-source.exr");
+    write_exr(
+        &source,
+        disc.size(),
+        disc.half_normals(),
+        Compression::ZIP16,
+        &[],
+    );
+    let (mut g, _) = read_ok(&source);
+    g.object_names.insert(5, "thing".to_string());
+    g.masks.insert("ramp".to_string(), disc.ramp());
+
+    let path = scratch("minimal.exr");
+    std::fs::write(&path, b"an older file to be replaced").unwrap();
+    g.write(&path).unwrap();
+    let meta = MetaData::read_from_file(&path, false).unwrap();
+    let names: Vec<String> = meta.headers[0]
+        .channels
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    assert_eq!(names, ["A", "N.X", "N.Y", "N.Z", "mask.ramp", "objectId"]);
+    let (back, _) = read_ok(&path);
+    assert_vectors_close(&back.normal, &g.normal, 1e-6, "N");
+    assert_eq!(back.object_names, g.object_names);
+    assert!(!back.has_view && !back.has_tangent);
+
+    // No temporary file is left beside it.
+    let folder = path.parent().unwrap();
+    let leftovers: Vec<_> = std::fs::read_dir(folder)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().starts_with(".minimal.exr"))
+        .collect();
+    assert!(leftovers.is_empty());
+}
+
+#[test]
+fn write_failures_are_io_errors_naming_the_file() {
+    let g = GBuffer::shaderball(8, 8);
+    let path = scratch("no-such-folder").join("out.exr");
+    let error = g.write(&path).unwrap_err();
+    assert_eq!(error.kind, ErrorKind::Io);
+    assert!(
+        error.to_string().starts_with(&path.display().to_string()),
+        "{error}"
+    );
+
+    let mut broken = g.clone();
+    broken.coverage.pop();
+    let error = broken.write(&scratch("broken.exr")).unwrap_err();
+    assert!(
+        error
+            .to_string()
+            .contains("coverage has 63 entries for 8x8 pixels"),
+        "{error}"
+    );
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -46,7 +46,12 @@
 //! anyway, since half floats are not exactly unit); `A` and mask values outside \[0,1\] (clamped);
 //! tangents at covered pixels that are zero, NaN/Inf or parallel to N (replaced by the stable
 //! frame). Stored tangents are otherwise made orthogonal to N by Gram–Schmidt.
-
+//!
+//! # Writing, and the built-in scene
+//!
+//! [`GBuffer::write`] stores `N.*` (and `V.*`, `T.*` where the g-buffer has them) as float, `A`
+//! and masks as half, `objectId` as uint, ZIP-compressed, through a temporary file that is
+//! renamed into place. [`GBuffer::shaderball`] makes the built-in look-dev scene without a file.
 
 mod frame;
 mod procedural;
@@ -54,6 +59,7 @@ mod read;
 mod scene;
 mod shaderball;
 mod validate;
+mod write;
 
 pub use frame::stable_tangent;
 
