@@ -8,6 +8,7 @@ pub mod atomic_file;
 pub mod cli;
 pub mod environment;
 pub mod error;
+pub mod gbuffer;
 pub mod gpu;
 pub mod material;
 pub mod render;

@@ -38,7 +38,15 @@ pub fn run(args: BenchArgs) -> Result<()> {
         "{:>10} {:>9} {:>16} {:>16} {:>14} {:>12}",
         "size", "coverage", "Msamples/s", "Msamples/s", "kernel/1spp", "wall"
     );
-    println!("{:>10} {:>9} {:>16} {:>16} {:>14} {:>12}", "", "", "(all pixels)", "(covered)", "(GPU, median)", format!("({} spp)", args.spp));
+    println!(
+        "{:>10} {:>9} {:>16} {:>16} {:>14} {:>12}",
+        "",
+        "",
+        "(all pixels)",
+        "(covered)",
+        "(GPU, median)",
+        format!("({} spp)", args.spp)
+    );
     for (width, height) in SIZES {
         let look = Look::builtin_default();
         let settings = Settings::resolve(&look, &Overrides::default())?;

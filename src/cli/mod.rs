@@ -61,8 +61,9 @@ fn list_devices() -> Result<()> {
 
 /// Parses `NAME=VALUE` for `--set`.
 pub fn parse_set(text: &str) -> Result<(Param, Value)> {
-    let (name, value) =
-        text.split_once('=').ok_or_else(|| Error::input(format!("--set {text}: expected NAME=VALUE, e.g. roughness=0.3")))?;
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| Error::input(format!("--set {text}: expected NAME=VALUE, e.g. roughness=0.3")))?;
     let param = Param::from_name(name.trim()).ok_or_else(|| {
         Error::input(format!("--set {text}: unknown parameter '{name}' (expected {})", Param::all_names()))
     })?;

@@ -3,8 +3,8 @@
 pub mod library;
 pub mod look;
 pub mod params;
-pub mod stack;
 pub mod preset;
+pub mod stack;
 mod toml_input;
 
 pub use look::Look;

@@ -52,8 +52,12 @@ impl PackedStacks {
     ) -> Result<PackedStacks> {
         let look_name = look.file.as_deref().map(|p| p.display().to_string()).unwrap_or_else(|| "built-in look".into());
         let mut masks: Vec<String> = Vec::new();
-        let mut packed =
-            PackedStacks { stacks: Vec::new(), layers: Vec::new(), masks: Vec::new(), stack_of_object: BTreeMap::new() };
+        let mut packed = PackedStacks {
+            stacks: Vec::new(),
+            layers: Vec::new(),
+            masks: Vec::new(),
+            stack_of_object: BTreeMap::new(),
+        };
         let mut unstyled = Vec::new();
         for id in object_ids {
             let first_layer = packed.layers.len() as u32;
@@ -71,7 +75,11 @@ impl PackedStacks {
                                             if available_masks.is_empty() {
                                                 "no masks".to_string()
                                             } else {
-                                                available_masks.iter().map(|m| format!("mask.{m}")).collect::<Vec<_>>().join(", ")
+                                                available_masks
+                                                    .iter()
+                                                    .map(|m| format!("mask.{m}"))
+                                                    .collect::<Vec<_>>()
+                                                    .join(", ")
                                             }
                                         ),
                                     ));

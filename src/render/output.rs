@@ -23,13 +23,14 @@ impl OutputFormat {
 /// Writes linear radiance as a float RGBA EXR. With a background, alpha is 1; without, it is the
 /// coverage and the colour is premultiplied by it, as compositors expect.
 pub fn write_exr(path: &Path, width: u32, height: u32, radiance: &[[f32; 4]], background: bool) -> Result<()> {
-    use exr::prelude::*;
+    use exr::prelude::{Encoding, Image, Layer, LayerAttributes, SpecificChannels, Vec2, WritableImage};
     let pixel = |position: Vec2<usize>| {
         let p = radiance[position.y() * width as usize + position.x()];
         (p[0], p[1], p[2], if background { 1.0 } else { p[3] })
     };
     let channels = SpecificChannels::rgba(pixel);
-    let layer = Layer::new((width as usize, height as usize), LayerAttributes::default(), Encoding::SMALL_LOSSLESS, channels);
+    let layer =
+        Layer::new((width as usize, height as usize), LayerAttributes::default(), Encoding::SMALL_LOSSLESS, channels);
     let mut bytes = std::io::Cursor::new(Vec::new());
     Image::from_layer(layer)
         .write()
@@ -48,7 +49,9 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[u8], with_alpha: 
             .write_to(&mut bytes, image::ImageFormat::Png)
     } else {
         let rgb: Vec<u8> = rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
-        image::RgbImage::from_raw(width, height, rgb).expect("buffer size matches").write_to(&mut bytes, image::ImageFormat::Png)
+        image::RgbImage::from_raw(width, height, rgb)
+            .expect("buffer size matches")
+            .write_to(&mut bytes, image::ImageFormat::Png)
     };
     encoded.map_err(|e| Error::io(path, format!("cannot encode the PNG ({e})")))?;
     atomic_file::write(path, bytes.get_ref())

@@ -114,8 +114,12 @@ impl Renderer {
             &[&[image, image, image], &environment::gpu::SET_LAYOUT],
             std::mem::size_of::<RelightPush>() as u32,
         )?;
-        let display =
-            ComputePipeline::new(ctx, &shaders::DISPLAY, &[&[image, image]], std::mem::size_of::<DisplayPush>() as u32)?;
+        let display = ComputePipeline::new(
+            ctx,
+            &shaders::DISPLAY,
+            &[&[image, image]],
+            std::mem::size_of::<DisplayPush>() as u32,
+        )?;
 
         let mut surface_data = Vec::with_capacity(3 * gbuffer.pixel_count());
         surface_data.extend(gbuffer.normal.iter().zip(&gbuffer.coverage).map(|(n, a)| [n[0], n[1], n[2], *a]));
@@ -128,10 +132,8 @@ impl Renderer {
 
         let gpu_environment = GpuEnvironment::upload(ctx, environment, &Distribution::build(environment))?;
         let environment_set = relight.bind(1, &gpu_environment.bindings())?;
-        let relight_set = relight.bind(
-            0,
-            &[Binding::Image(&surface), Binding::Image(&resolved), Binding::Image(&accumulation)],
-        )?;
+        let relight_set =
+            relight.bind(0, &[Binding::Image(&surface), Binding::Image(&resolved), Binding::Image(&accumulation)])?;
         let display_set = display.bind(0, &[Binding::Image(&accumulation), Binding::Image(&display_image)])?;
         Ok(Renderer {
             ctx: ctx.clone(),
@@ -214,8 +216,13 @@ impl Renderer {
         )?;
         let groups = [group_count(width, LOCAL_SIZE), group_count(height, LOCAL_SIZE), 1];
         let time = self.timed(|renderer, cmd| renderer.resolve.dispatch(cmd, &[&set], &[], groups))?;
-        self.stacks =
-            Some(GpuStacks { _stack_index: stack_index, _masks: masks, _stacks: stacks, _layers: layer_buffer, _set: set });
+        self.stacks = Some(GpuStacks {
+            _stack_index: stack_index,
+            _masks: masks,
+            _stacks: stacks,
+            _layers: layer_buffer,
+            _set: set,
+        });
         self.samples = 0;
         Ok(KernelTimes { resolve: time, relight: None })
     }

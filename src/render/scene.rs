@@ -25,7 +25,13 @@ pub struct Scene {
 
 impl Scene {
     /// Packs the look's stacks for the objects in the g-buffer.
-    pub fn new(gbuffer: GBuffer, gbuffer_name: PathBuf, look: Look, environment: Environment, settings: Settings) -> Result<Scene> {
+    pub fn new(
+        gbuffer: GBuffer,
+        gbuffer_name: PathBuf,
+        look: Look,
+        environment: Environment,
+        settings: Settings,
+    ) -> Result<Scene> {
         let mut ids: Vec<u32> = gbuffer.object_id.clone();
         ids.sort_unstable();
         ids.dedup();

@@ -1,0 +1,121 @@
+//! The g-buffer: everything the relighter needs per pixel, read from an OpenEXR file or made by
+//! the built-in shader-ball scene.
+//!
+//! # File format
+//!
+//! One single-part scan-line or tiled OpenEXR image. Samples may be half, float or uint; any
+//! compression the `exr` crate reads is accepted (none, RLE, ZIPS, ZIP, PIZ, PXR24, B44, B44A,
+//! DWAA, DWAB). Row 0 is the top of the image; the data window's size is used and its offset
+//! ignored. Channels, by exact name:
+//!
+//! | channel | meaning | if absent |
+//! |---|---|---|
+//! | `N.X N.Y N.Z` | world-space unit shading normal | error (required) |
+//! | `V.X V.Y V.Z` | unit vector from the surface toward the eye | (0,0,1) |
+//! | `T.X T.Y T.Z` | world-space tangent, for anisotropy | [`stable_tangent`] of N |
+//! | `A` | coverage in \[0,1\]; 0 is background | 1 where \|N\| > 0.5, else 0 |
+//! | `objectId` | integer object ID: uint, or half/float holding non-negative integers | 0 |
+//! | `mask.<name>` | layer mask in \[0,1\], named `<name>` in looks | — |
+//!
+//! A triple must be complete: `V.X` without `V.Y` is an error. Other channels are ignored.
+//!
+//! Prefer a lossless compression (ZIP, PIZ) for g-buffers. DWAA and DWAB treat every channel
+//! whose name ends in `.Y` as luminance and quantise it, so `N.Y`, `V.Y` and `T.Y` come back
+//! with errors around 1e-3 while the X and Z components are exact; B44 quantises every half
+//! channel.
+//!
+//! # Object names
+//!
+//! Object names live in the header as text attributes named `objectName.<ID>`, where `<ID>` is
+//! the decimal object ID and the value is the name in UTF-8, for example
+//! `objectName.1 = "ball"`, `objectName.2 = "pedestal"`. They are read on load and written on
+//! save. An attribute whose ID is not a decimal u32, or whose value is not text, is skipped with
+//! a warning.
+//!
+//! # Validation
+//!
+//! A pixel is *covered* where `A > 0`, or, in a file without `A`, wherever N is not a clearly
+//! empty vector (\|N\| ≤ 0.5). Reading fails, with one line naming the file and the problem, on:
+//! a missing file; a file the `exr` crate cannot read; more than one part; an empty image; a
+//! missing `N.*` channel; an incomplete triple; NaN/Inf normals at covered pixels; \|N\| < 0.5
+//! where `A` > 0; NaN/Inf or zero-length view vectors anywhere; NaN/Inf in `A` or a mask; and
+//! object IDs that are negative or not integers. Counts and the first offending pixel are given.
+//!
+//! These are fixed, with one warning line each, naming the file and the count:
+//! normals at covered pixels whose length is off by more than 1% (all normals are renormalised
+//! anyway, since half floats are not exactly unit); `A` and mask values outside \[0,1\] (clamped);
+//! tangents at covered pixels that are zero, NaN/Inf or parallel to N (replaced by the stable
+//! frame). Stored tangents are otherwise made orthogonal to N by Gram–Schmidt.
+//!
+//! # Writing, and the built-in scene
+//!
+//! [`GBuffer::write`] stores `N.*` (and `V.*`, `T.*` where the g-buffer has them) as float, `A`
+//! and masks as half, `objectId` as uint, ZIP-compressed, through a temporary file that is
+//! renamed into place. [`GBuffer::shaderball`] makes the built-in look-dev scene without a file.
+
+mod frame;
+mod procedural;
+mod read;
+mod scene;
+mod shaderball;
+mod validate;
+mod write;
+
+pub use frame::stable_tangent;
+
+use std::collections::BTreeMap;
+
+/// Channel names of the file format.
+pub const NORMAL_CHANNELS: [&str; 3] = ["N.X", "N.Y", "N.Z"];
+pub const VIEW_CHANNELS: [&str; 3] = ["V.X", "V.Y", "V.Z"];
+pub const TANGENT_CHANNELS: [&str; 3] = ["T.X", "T.Y", "T.Z"];
+pub const COVERAGE_CHANNEL: &str = "A";
+pub const OBJECT_ID_CHANNEL: &str = "objectId";
+/// A mask channel is this prefix followed by the mask's name.
+pub const MASK_PREFIX: &str = "mask.";
+/// An object's name is stored in the header attribute with this prefix followed by its ID.
+pub const OBJECT_NAME_PREFIX: &str = "objectName.";
+
+/// The view vector of a file without `V.*`: an orthographic camera looking down −Z.
+pub const DEFAULT_VIEW: [f32; 3] = [0.0, 0.0, 1.0];
+/// The normal stored where a pixel is not covered and the file's normal is unusable.
+pub const PLACEHOLDER_NORMAL: [f32; 3] = [0.0, 0.0, 1.0];
+
+/// A validated g-buffer: everything the renderer needs, per pixel, row 0 at the top.
+///
+/// Every per-pixel vector holds `width * height` entries in row-major order. Directions are unit
+/// length everywhere, including background pixels, so kernels need no guards.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GBuffer {
+    pub width: u32,
+    pub height: u32,
+    /// Unit world-space shading normal; [`PLACEHOLDER_NORMAL`] where coverage is 0 and the
+    /// file's normal is unusable.
+    pub normal: Vec<[f32; 3]>,
+    /// Unit vector from the surface toward the eye; [`DEFAULT_VIEW`] when the file has no `V.*`.
+    /// On background pixels of the shader ball it is minus the camera ray, so the environment
+    /// behind the objects can be shown.
+    pub view: Vec<[f32; 3]>,
+    /// Unit tangent, orthogonal to `normal`: the stored `T.*` after Gram–Schmidt, or the
+    /// [`stable_tangent`] of the normal. The bitangent is `cross(normal, tangent)`.
+    pub tangent: Vec<[f32; 3]>,
+    /// Coverage in \[0,1\]: 0 is background, fractional values antialias silhouettes.
+    pub coverage: Vec<f32>,
+    /// Object ID; 0 when the file has no `objectId` channel.
+    pub object_id: Vec<u32>,
+    /// Layer masks in \[0,1\], keyed by name without the `mask.` prefix.
+    pub masks: BTreeMap<String, Vec<f32>>,
+    /// Object names by ID, from the `objectName.<ID>` header attributes.
+    pub object_names: BTreeMap<u32, String>,
+    /// Whether the file carried `V.*`.
+    pub has_view: bool,
+    /// Whether the file carried `T.*`.
+    pub has_tangent: bool,
+}
+
+impl GBuffer {
+    /// The number of pixels, `width * height`.
+    pub fn pixel_count(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+}

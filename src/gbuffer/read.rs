@@ -1,0 +1,93 @@
+//! Reading a g-buffer file: OpenEXR decoding, then validation (in `validate`).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use exr::prelude::{AttributeValue, FlatSamples, ReadChannels, ReadLayers, Text};
+
+use super::validate::{self, RawImage};
+use super::{GBuffer, OBJECT_NAME_PREFIX};
+use crate::{Error, Result};
+
+impl GBuffer {
+    /// Reads and validates a g-buffer file, printing fix-up warnings to stderr.
+    /// See the module documentation for the format, the errors and the fix-ups.
+    pub fn read(path: &Path) -> Result<GBuffer> {
+        let (gbuffer, warnings) = GBuffer::read_with_warnings(path)?;
+        for warning in warnings {
+            crate::warn(warning);
+        }
+        Ok(gbuffer)
+    }
+
+    /// Like [`GBuffer::read`], but returns the warnings (one line each, naming the file) instead
+    /// of printing them, for callers that show them elsewhere, such as the viewer.
+    pub fn read_with_warnings(path: &Path) -> Result<(GBuffer, Vec<String>)> {
+        let raw = read_exr(path)?;
+        validate::build(path, raw)
+    }
+}
+
+/// Decodes the single part of an EXR file into named channels, without judging their contents.
+fn read_exr(path: &Path) -> Result<RawImage> {
+    check_is_file(path)?;
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .all_layers()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| Error::input_file(path, format!("not a readable OpenEXR file ({e})")))?;
+
+    let part_count = image.layer_data.len();
+    let mut parts = image.layer_data.into_iter();
+    let (Some(layer), None) = (parts.next(), parts.next()) else {
+        return Err(Error::input_file(
+            path,
+            format!("the file has {part_count} parts; only single-part g-buffers are supported"),
+        ));
+    };
+
+    let channels: BTreeMap<String, FlatSamples> = layer
+        .channel_data
+        .list
+        .into_iter()
+        .map(|channel| (text_to_string(&channel.name), channel.sample_data))
+        .collect();
+
+    // Unknown attributes may land in either set, depending on their type.
+    let attributes = layer.attributes.other.iter().chain(image.attributes.other.iter());
+    let object_name_attributes = attributes
+        .filter_map(|(name, value)| {
+            let name = text_to_string(name);
+            name.starts_with(OBJECT_NAME_PREFIX).then(|| (name, attribute_text(value)))
+        })
+        .collect();
+
+    Ok(RawImage { width: layer.size.0, height: layer.size.1, channels, object_name_attributes })
+}
+
+/// A clear error for a path that is not there or not a file, before the EXR decoder words it.
+fn check_is_file(path: &Path) -> Result<()> {
+    match std::fs::metadata(path) {
+        Ok(meta) if meta.is_file() => Ok(()),
+        Ok(_) => Err(Error::input_file(path, "not a file")),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(Error::input_file(path, "file not found")),
+        Err(e) => Err(Error::input_file(path, format!("cannot open the file ({e})"))),
+    }
+}
+
+/// The value of a text attribute, or `None` for any other type.
+fn attribute_text(value: &AttributeValue) -> Option<String> {
+    match value {
+        AttributeValue::Text(text) => Some(text_to_string(text)),
+        _ => None,
+    }
+}
+
+/// EXR text is a byte string; OpenEXR's own library treats it as UTF-8, and so do we (the `exr`
+/// crate's `Display` would read it as Latin-1 and garble non-ASCII names).
+pub(crate) fn text_to_string(text: &Text) -> String {
+    String::from_utf8_lossy(text.bytes()).into_owned()
+}
