@@ -35,18 +35,19 @@ uint nested_uniform_scramble(uint x, uint seed) {
     return bitfieldReverse(laine_karras_permutation(bitfieldReverse(x), seed));
 }
 
-// Sobol dimension 1 (primitive polynomial x + 1): its direction numbers are the rows of Pascal's
-// triangle mod 2, generated on the fly. Dimension 0 is bitfieldReverse(index).
+// Sobol dimension 1 (primitive polynomial x + 1), whose generator matrix is Pascal's triangle
+// mod 2. By Lucas' theorem, C(j, i) is odd exactly when the bits of i are a subset of those of j,
+// so output bit 31 − i is the XOR of the index bits j ⊇ i: a superset XOR transform over the
+// five bits of a bit position, five shift-and-mask steps instead of a 32-step loop.
+// Dimension 0 is bitfieldReverse(index).
 uint sobol_dimension1(uint index) {
-    uint result = 0u;
-    uint direction = 0x80000000u;
-    for (uint bit = 0u; bit < 32u; bit++) {
-        if ((index & (1u << bit)) != 0u) {
-            result ^= direction;
-        }
-        direction ^= direction >> 1;
-    }
-    return result;
+    uint z = index;
+    z ^= (z >> 1) & 0x55555555u;
+    z ^= (z >> 2) & 0x33333333u;
+    z ^= (z >> 4) & 0x0f0f0f0fu;
+    z ^= (z >> 8) & 0x00ff00ffu;
+    z ^= (z >> 16) & 0x0000ffffu;
+    return bitfieldReverse(z);
 }
 
 // 24 high bits to a float in [0, 1), exactly.

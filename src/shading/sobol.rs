@@ -30,17 +30,16 @@ pub fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
     laine_karras_permutation(x.reverse_bits(), seed).reverse_bits()
 }
 
-/// Sobol dimension 1 (primitive polynomial x + 1); dimension 0 is `index.reverse_bits()`.
+/// Sobol dimension 1 (primitive polynomial x + 1) by a superset XOR transform over bit
+/// positions (see sobol.glsl); dimension 0 is `index.reverse_bits()`.
 pub fn sobol_dimension1(index: u32) -> u32 {
-    let mut result = 0;
-    let mut direction = 0x8000_0000u32;
-    for bit in 0..32 {
-        if index & (1 << bit) != 0 {
-            result ^= direction;
-        }
-        direction ^= direction >> 1;
-    }
-    result
+    let mut z = index;
+    z ^= (z >> 1) & 0x5555_5555;
+    z ^= (z >> 2) & 0x3333_3333;
+    z ^= (z >> 4) & 0x0f0f_0f0f;
+    z ^= (z >> 8) & 0x00ff_00ff;
+    z ^= (z >> 16) & 0x0000_ffff;
+    z.reverse_bits()
 }
 
 /// 24 high bits to a float in [0, 1), exactly.
@@ -73,8 +72,8 @@ mod tests {
 
     #[test]
     fn dimension1_matches_the_generator_matrix_and_known_values() {
-        for i in 0..4096 {
-            assert_eq!(sobol_dimension1(i), dimension1_by_matrix(i));
+        for i in (0..4096).chain((0..4096).map(|k: u32| k.wrapping_mul(0x9e37_79b9))) {
+            assert_eq!(sobol_dimension1(i), dimension1_by_matrix(i), "index {i:#x}");
         }
         // The first points of Sobol dimension 1 in index (not Gray-code) order.
         let expected = [0.0, 0.5, 0.75, 0.25, 0.625, 0.125, 0.375, 0.875];
