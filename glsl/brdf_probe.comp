@@ -16,7 +16,7 @@ struct Record {
 layout(set = 0, binding = 0, std430) readonly buffer Records {
     Record records[];
 };
-// rgb: f(l, v); a: brdf_pdf(l, v).
+// rgb: f(l, v); a: brdf_pdf(l, v) for v above the surface (the renderer never samples below it).
 layout(set = 0, binding = 1, std430) writeonly buffer Results {
     vec4 results[];
 };
@@ -28,6 +28,8 @@ void main() {
     }
     Record r = records[i];
     Lobes s = make_lobes(unpack_material(r.params[0], r.params[1], r.params[2], r.params[3]));
-    LobeChoice choice = choose_lobes(s, r.v.z);
-    results[i] = vec4(disney_brdf(s, r.l.xyz, r.v.xyz), brdf_pdf(s, choice, r.l.xyz, r.v.xyz));
+    View view = make_view(s, r.v.xyz);
+    HalfVector hv = make_half_vector(s, r.l.xyz, r.v.xyz);
+    float pdf = r.v.z > 0.0 ? brdf_pdf(choose_lobes(s, view), view, r.l.xyz, hv) : 0.0;
+    results[i] = vec4(disney_brdf(s, view, r.l.xyz, hv), pdf);
 }

@@ -38,29 +38,32 @@ vec3 to_environment(vec3 d) {
                 d.x * pass.sin_rotation + d.z * pass.cos_rotation);
 }
 
-// One MIS estimate of reflected radiance toward v; the frame is the shading frame expressed in
-// environment space, so no per-sample rotation is needed.
-vec3 estimate(Lobes s, LobeChoice choice, vec3 v, vec3 fx, vec3 fy, vec3 fn, vec2 u_env, vec2 u_brdf) {
+// One MIS estimate of reflected radiance toward the view; the frame (fx, fy, fn) is the shading
+// frame expressed in environment space, so no per-sample rotation is needed.
+vec3 estimate(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, vec2 u_env, vec2 u_brdf) {
     vec3 result = vec3(0.0);
 
     vec2 uv;
-    float pdf_env;
-    vec3 d = env_sample(u_env, uv, pdf_env);
+    vec4 texel;
+    vec3 d = env_sample(u_env, uv, texel);
     vec3 l = vec3(dot(d, fx), dot(d, fy), dot(d, fn));
+    float pdf_env = env_pdf(texel.a, d);
     if (l.z > 0.0 && pdf_env > 0.0) {
-        vec3 f = disney_brdf(s, l, v);
-        float pdf_brdf = brdf_pdf(s, choice, l, v);
-        result += f * (l.z * mis_weight_over_pdf(pdf_env, pdf_brdf)) * env_radiance(uv);
+        HalfVector hv = make_half_vector(s, l, view.v);
+        vec3 f = disney_brdf(s, view, l, hv);
+        float pdf_brdf = brdf_pdf(choice, view, l, hv);
+        result += f * (l.z * mis_weight_over_pdf(pdf_env, pdf_brdf)) * texel.rgb;
     }
 
-    l = sample_brdf(s, choice, v, u_brdf);
+    l = sample_brdf(s, choice, view, u_brdf);
     if (l.z > 0.0) {
-        float pdf_brdf = brdf_pdf(s, choice, l, v);
+        HalfVector hv = make_half_vector(s, l, view.v);
+        float pdf_brdf = brdf_pdf(choice, view, l, hv);
         if (pdf_brdf > 0.0) {
             d = normalize(l.x * fx + l.y * fy + l.z * fn);
-            uv = env_direction_to_uv(d);
-            vec3 f = disney_brdf(s, l, v);
-            result += f * (l.z * mis_weight_over_pdf(pdf_brdf, env_pdf(uv, d))) * env_radiance(uv);
+            texel = env_texel(env_direction_to_uv(d));
+            vec3 f = disney_brdf(s, view, l, hv);
+            result += f * (l.z * mis_weight_over_pdf(pdf_brdf, env_pdf(texel.a, d))) * texel.rgb;
         }
     }
     return result * pass.intensity;
@@ -78,7 +81,7 @@ void main() {
 
     vec3 background = vec3(0.0);
     if (pass.show_background != 0u && coverage < 1.0) {
-        background = pass.intensity * env_radiance(env_direction_to_uv(to_environment(-view)));
+        background = pass.intensity * env_background(env_direction_to_uv(to_environment(-view)));
     }
     vec4 sum = pass.first_sample == 0u ? vec4(0.0) : imageLoad(accumulation, pixel);
     uint last = pass.first_sample + pass.sample_count;
@@ -91,7 +94,8 @@ void main() {
         Material m = unpack_material(imageLoad(resolved, ivec3(pixel, 0)), imageLoad(resolved, ivec3(pixel, 1)),
                                      imageLoad(resolved, ivec3(pixel, 2)), imageLoad(resolved, ivec3(pixel, 3)));
         Lobes s = make_lobes(m);
-        LobeChoice choice = choose_lobes(s, v.z);
+        View view = make_view(s, v);
+        LobeChoice choice = choose_lobes(s, view);
         vec3 fx = to_environment(t);
         vec3 fy = to_environment(b);
         vec3 fn = to_environment(n);
@@ -101,7 +105,7 @@ void main() {
         for (uint i = pass.first_sample; i < last; i++) {
             vec3 radiance = vec3(0.0);
             if (v.z > 0.0) {
-                radiance = estimate(s, choice, v, fx, fy, fn, sobol_owen_2d(i, env_seed), sobol_owen_2d(i, brdf_seed));
+                radiance = estimate(s, choice, view, fx, fy, fn, sobol_owen_2d(i, env_seed), sobol_owen_2d(i, brdf_seed));
             }
             sum += vec4(coverage * radiance + (1.0 - coverage) * background, coverage);
         }

@@ -39,28 +39,29 @@ void main() {
         return;
     }
     Lobes s = make_lobes(unpack_material(params[0], params[1], params[2], params[3]));
-    LobeChoice choice = choose_lobes(s, view.z);
-    vec3 v = view.xyz;
+    View v = make_view(s, view.xyz);
+    LobeChoice choice = choose_lobes(s, v);
     vec2 u = uniforms[i];
     vec4 result;
     if (routine == ROUTINE_COSINE) {
-        vec3 l = sample_cosine(u);
+        vec3 l = sample_cosine(azimuth(u.x), u.y);
         result = vec4(l, pdf_cosine(l));
     } else if (routine == ROUTINE_GGX) {
-        vec3 h = sample_ggx_visible_normal(v, s.ax, s.ay, u);
-        result = vec4(reflect(-v, h), pdf_ggx_reflection(v, h, s.ax, s.ay));
+        vec3 l = reflect(-v.v, sample_ggx_visible_normal(v.v_stretched, s.ax, s.ay, azimuth(u.x), u.y));
+        result = vec4(l, pdf_ggx_reflection(v, make_half_vector(s, l, v.v)));
     } else if (routine == ROUTINE_GTR1) {
-        vec3 h = sample_gtr1_normal(s.cc_alpha2, u);
-        result = vec4(reflect(-v, h), pdf_gtr1_reflection(v, h, s.cc_alpha2, s.cc_norm));
+        vec3 l = reflect(-v.v, sample_gtr1_normal(s.cc_alpha2, s.cc_log2_alpha2, azimuth(u.x), u.y));
+        result = vec4(l, pdf_gtr1_reflection(v, make_half_vector(s, l, v.v)));
     } else if (routine == ROUTINE_BRDF) {
         vec3 l = sample_brdf(s, choice, v, u);
-        result = vec4(l, brdf_pdf(s, choice, l, v));
+        result = vec4(l, brdf_pdf(choice, v, l, make_half_vector(s, l, v.v)));
     } else if (routine == ROUTINE_ENVIRONMENT) {
         vec2 uv;
-        float pdf;
-        vec3 d = env_sample(u, uv, pdf);
+        vec4 texel;
+        vec3 d = env_sample(u, uv, texel);
+        float pdf = env_pdf(texel.a, d);
         // Also check that looking the pdf up from the direction agrees with the sampler's own.
-        float looked_up = env_pdf(env_direction_to_uv(d), d);
+        float looked_up = env_pdf(env_texel(env_direction_to_uv(d)).a, d);
         result = vec4(d, abs(looked_up - pdf) <= 1e-3 * pdf ? pdf : -1.0);
     } else if (routine == ROUTINE_SOBOL) {
         result = vec4(sobol_owen_2d(i, seed), 0.0, 0.0);

@@ -7,7 +7,7 @@ use common::random::Random;
 use glam::Vec3;
 use lookdev::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context};
 use lookdev::material::{Param, Params};
-use lookdev::shading::brdf::{disney_brdf, make_lobes};
+use lookdev::shading::brdf::{disney_brdf, make_half_vector, make_lobes, make_view};
 use lookdev::shading::sampling::{brdf_pdf, choose_lobes};
 
 /// One probe record, laid out as `Record` in brdf_probe.comp.
@@ -69,11 +69,14 @@ fn gpu_brdf_and_pdf_match_the_rust_reference() {
     let mut params = Vec::new();
     for _ in 0..8192 {
         let p = random_params(&mut rng);
-        // Mostly the upper hemisphere; a few below it to check the zero branch.
+        // Mostly the upper hemisphere; some below it to check the zero branch and the pdf of
+        // directions below the horizon.
         let mut l = rng.direction();
         let mut v = rng.direction();
-        if rng.next_u32() % 16 != 0 {
+        if rng.next_u32() % 8 != 0 {
             l.z = l.z.abs();
+        }
+        if rng.next_u32() % 16 != 0 {
             v.z = v.z.abs();
         }
         records.push(Record { params: p.to_gpu(), l: l.extend(0.0).to_array(), v: v.extend(0.0).to_array() });
@@ -85,8 +88,10 @@ fn gpu_brdf_and_pdf_match_the_rust_reference() {
         let lobes = make_lobes(&params[i]);
         let l = Vec3::from_slice(&record.l[..3]);
         let v = Vec3::from_slice(&record.v[..3]);
-        let f = disney_brdf(&lobes, l, v);
-        let pdf = brdf_pdf(&lobes, &choose_lobes(&lobes, v.z), l, v);
+        let view = make_view(&lobes, v);
+        let hv = make_half_vector(&lobes, l, v);
+        let f = disney_brdf(&lobes, &view, l, &hv);
+        let pdf = if v.z > 0.0 { brdf_pdf(&choose_lobes(&lobes, &view), &view, l, &hv) } else { 0.0 };
         for (c, (&gpu, cpu)) in result.iter().zip([f.x, f.y, f.z, pdf]).enumerate() {
             assert!(gpu.is_finite(), "record {i} channel {c}: GPU gave {gpu}");
             if cpu > 1e-4 {

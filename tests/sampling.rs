@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 use lookdev::environment::{self, Distribution, Environment, GpuEnvironment};
 use lookdev::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context};
 use lookdev::material::Params;
-use lookdev::shading::brdf::make_lobes;
+use lookdev::shading::brdf::{make_half_vector, make_lobes, make_view};
 use lookdev::shading::{sampling, sobol};
 
 const COSINE: u32 = 0;
@@ -57,13 +57,28 @@ impl Probe {
         uniforms: &[Vec2],
         env: &Environment,
     ) -> Vec<(Vec3, f32)> {
+        self.run_with(routine, params, view, seed, uniforms, env, &Distribution::build(env))
+    }
+
+    /// As `run`, with the environment's sampling tables given.
+    #[allow(clippy::too_many_arguments)]
+    fn run_with(
+        &self,
+        routine: u32,
+        params: &Params,
+        view: Vec3,
+        seed: u32,
+        uniforms: &[Vec2],
+        env: &Environment,
+        distribution: &Distribution,
+    ) -> Vec<(Vec3, f32)> {
         let ctx = &self.ctx;
         let setup = Setup { params: params.to_gpu(), view: view.extend(0.0).to_array(), routine, seed, pad: [0; 2] };
         let setup = Buffer::with_data(ctx, bytemuck::bytes_of(&setup)).unwrap();
         let flat: Vec<f32> = uniforms.iter().flat_map(|u| [u.x, u.y]).collect();
         let uniforms_buffer = Buffer::with_data(ctx, bytemuck::cast_slice(&flat)).unwrap();
         let output = Buffer::storage(ctx, uniforms.len() as u64 * 16).unwrap();
-        let gpu_env = GpuEnvironment::upload(ctx, env, &Distribution::build(env)).unwrap();
+        let gpu_env = GpuEnvironment::upload(ctx, env, distribution).unwrap();
         let set0 = self
             .pipeline
             .bind(0, &[Binding::Buffer(&setup), Binding::Buffer(&uniforms_buffer), Binding::Buffer(&output)])
@@ -199,14 +214,15 @@ fn brdf_samplers_match_their_pdfs() {
     for (index, (name, routine, params, v)) in cases.iter().enumerate() {
         let samples = probe.run(*routine, params, *v, 0, &uniforms(SAMPLES, index as u32), &env);
         let lobes = make_lobes(params);
-        let choice = sampling::choose_lobes(&lobes, v.z);
+        let view = make_view(&lobes, *v);
+        let choice = sampling::choose_lobes(&lobes, &view);
         let pdf = |l: Vec3| -> f64 {
-            let h = (l + *v).normalize();
+            let hv = make_half_vector(&lobes, l, *v);
             (match *routine {
                 COSINE => sampling::pdf_cosine(l),
-                GGX => sampling::pdf_ggx_reflection(*v, h, lobes.ax, lobes.ay),
-                GTR1 => sampling::pdf_gtr1_reflection(*v, h, lobes.cc_alpha2, lobes.cc_norm),
-                _ => sampling::brdf_pdf(&lobes, &choice, l, *v),
+                GGX => sampling::pdf_ggx_reflection(&view, &hv),
+                GTR1 => sampling::pdf_gtr1_reflection(&view, &hv),
+                _ => sampling::brdf_pdf(&choice, &view, l, &hv),
             }) as f64
         };
         // Near l = −v the half vector, and so the reference pdf, is ill-conditioned.
@@ -257,19 +273,27 @@ fn check_environment_cells(env: &Environment, distribution: &Distribution, sampl
     let (nx, ny) = (cols.div_ceil(bx) as usize, rows.div_ceil(by) as usize);
     let mut expected = vec![0.0; nx * ny];
     for row in 0..rows {
+        let (y0, y1) = distribution.cell_span(row, distribution.height);
         for column in 0..cols {
-            let p = distribution.cell_pdf[(row * cols + column) as usize] as f64 / (cols * rows) as f64;
+            let (x0, x1) = distribution.cell_span(column, distribution.width);
+            let area = ((x1 - x0) * (y1 - y0)) as f64 / (distribution.width * distribution.height) as f64;
+            let p = distribution.cell_pdf[(row * cols + column) as usize] as f64 * area;
             expected[(row / by) as usize * nx + (column / bx) as usize] += p * samples.len() as f64;
         }
     }
     let mut observed = vec![0.0; nx * ny];
     let mut inside = vec![0.0; 64];
     for (d, _) in samples {
-        let uv = environment::sampling::direction_to_uv(*d) * Vec2::new(cols as f32, rows as f32);
-        let (cx, cy) = ((uv.x as u32).min(cols - 1), (uv.y as u32).min(rows - 1));
+        let uv = environment::sampling::direction_to_uv(*d);
+        let texel = environment::sampling::texel_of(distribution.width, distribution.height, uv);
+        let (cx, cy) = (texel.x / distribution.block, texel.y / distribution.block);
         observed[(cy / by) as usize * nx + (cx / bx) as usize] += 1.0;
-        let (fx, fy) = (uv.x - cx as f32, uv.y - cy as f32);
-        inside[((fy * 8.0) as usize).min(7) * 8 + ((fx * 8.0) as usize).min(7)] += 1.0;
+        // Where the sample lies inside its cell, in [0, 1)².
+        let (x0, x1) = distribution.cell_span(cx, distribution.width);
+        let (y0, y1) = distribution.cell_span(cy, distribution.height);
+        let p = uv * Vec2::new(distribution.width as f32, distribution.height as f32);
+        let (fx, fy) = ((p.x - x0 as f32) / (x1 - x0) as f32, (p.y - y0 as f32) / (y1 - y0) as f32);
+        inside[((fy * 8.0).max(0.0) as usize).min(7) * 8 + ((fx * 8.0).max(0.0) as usize).min(7)] += 1.0;
     }
     assert_chi_square(&format!("{name}, cells"), &observed, &expected);
     let uniform = vec![samples.len() as f64 / 64.0; 64];
@@ -286,6 +310,13 @@ fn environment_sampling_matches_its_pdf() {
             probe.run(ENVIRONMENT, &Params::default(), Vec3::Z, 0, &uniforms(SAMPLES, 100 + index as u32), env);
         check_environment_cells(env, &distribution, &samples);
     }
+    // Maps wider than the cell grid use blocks of texels, with smaller blocks at the edges.
+    let env = sun_and_sky(301, 150);
+    let blocked = Distribution::with_max_columns(&env, 64);
+    assert_eq!((blocked.block, blocked.columns, blocked.rows), (5, 61, 30));
+    let samples = probe.run_with(ENVIRONMENT, &Params::default(), Vec3::Z, 0, &uniforms(SAMPLES, 300), &env, &blocked);
+    check_environment_cells(&env, &blocked, &samples);
+
     // pdf_ω integrates to 1 over the sphere, by a quadrature that knows nothing of the cells
     // (so only for maps without a sun too small for it to resolve).
     for env in [&envs[0], &envs[3]] {
@@ -333,15 +364,16 @@ fn the_reference_samplers_match_their_pdfs_too() {
     let params = material(0.6, 0.4, 0.0, 1.0, 0.4);
     let v = view(50.0, 30.0);
     let lobes = make_lobes(&params);
-    let choice = sampling::choose_lobes(&lobes, v.z);
+    let view = make_view(&lobes, v);
+    let choice = sampling::choose_lobes(&lobes, &view);
     let samples: Vec<(Vec3, f32)> = uniforms(1 << 18, 77)
         .into_iter()
         .map(|u| {
-            let l = sampling::sample_brdf(&lobes, &choice, v, u);
-            (l, sampling::brdf_pdf(&lobes, &choice, l, v))
+            let l = sampling::sample_brdf(&lobes, &choice, &view, u);
+            (l, sampling::brdf_pdf(&choice, &view, l, &make_half_vector(&lobes, l, v)))
         })
         .collect();
-    let pdf = |l: Vec3| sampling::brdf_pdf(&lobes, &choice, l, v) as f64;
+    let pdf = |l: Vec3| sampling::brdf_pdf(&choice, &view, l, &make_half_vector(&lobes, l, v)) as f64;
     check_routine("reference mixture", &samples, &pdf, &|_| true, &SphereBins { theta: 16, phi: 32 });
 
     let env = sun_and_sky(120, 60);
@@ -349,7 +381,8 @@ fn the_reference_samplers_match_their_pdfs_too() {
     let samples: Vec<(Vec3, f32)> = uniforms(1 << 18, 78)
         .into_iter()
         .map(|u| {
-            let (d, _, pdf) = distribution.sample(u);
+            let (d, _, texel) = distribution.sample(u);
+            let pdf = distribution.sample_pdf(d, texel);
             let looked_up = distribution.pdf(environment::sampling::direction_to_uv(d), d);
             (d, if (looked_up - pdf).abs() <= 1e-3 * pdf { pdf } else { -1.0 })
         })

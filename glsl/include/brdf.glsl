@@ -1,6 +1,8 @@
 // The Disney 2012 principled BRDF, BRDF Explorer revision (LOOKDEV.md §4).
 //
 // Every vector is in the shading frame: N = +Z, tangent X = +X, bitangent Y = +Y, so N·W = W.z.
+// What depends only on the material (Lobes) or only on the view (View) is computed once per
+// pixel; what depends on the half vector (HalfVector) is shared by f and the sampling pdf.
 // Mirrored function by function in src/shading/brdf.rs.
 #ifndef LOOKDEV_BRDF_GLSL
 #define LOOKDEV_BRDF_GLSL
@@ -11,16 +13,17 @@
 // What the BRDF needs of a material, derived once per pixel rather than once per sample.
 struct Lobes {
     vec3 base_color;
-    vec3 cspec0;       // specular reflectance at normal incidence
-    vec3 sheen_color;  // sheen · Csheen
+    vec3 cspec0;          // specular reflectance at normal incidence
+    vec3 sheen_color;     // sheen · Csheen
     float metallic;
     float subsurface;
     float roughness;
-    float ax;          // anisotropic GGX alphas
+    float ax;             // anisotropic GGX alphas
     float ay;
-    float clearcoat;   // 0.25 · clearcoat: the clearcoat lobe's weight in the total
-    float cc_alpha2;   // GTR1 alpha², at most 1
-    float cc_norm;     // GTR1 normalisation (α²−1)/(π·ln α²), or 1/π when α ≥ 1
+    float clearcoat;      // 0.25 · clearcoat: the clearcoat lobe's weight in the total
+    float cc_alpha2;      // GTR1 alpha², at most 1
+    float cc_log2_alpha2; // for sampling GTR1
+    float cc_norm;        // GTR1 normalisation (α²−1)/(π·ln α²), or 1/π when α ≥ 1
 };
 
 // Burley's luminance approximation, used only to isolate the base colour's hue for the tints.
@@ -49,6 +52,7 @@ Lobes make_lobes(Material m) {
     s.clearcoat = 0.25 * m.clearcoat;
     float a = mix(0.1, 0.001, m.clearcoat_gloss);
     s.cc_alpha2 = min(a * a, 1.0);
+    s.cc_log2_alpha2 = log2(s.cc_alpha2);
     s.cc_norm = gtr1_norm(s.cc_alpha2);
     return s;
 }
@@ -88,39 +92,71 @@ float smith_g_clearcoat(float cos_w) {
     return 1.0 / (cos_w + sqrt(0.0625 + c2 - 0.0625 * c2));
 }
 
+// What depends only on the view direction, derived once per pixel.
+struct View {
+    vec3 v;
+    vec3 v_stretched;  // v in the GGX hemisphere configuration, for visible-normal sampling
+    float fv;          // S(N·V)
+    float g_spec;      // g(V) of the specular lobe
+    float g_coat;      // g25(V) of the clearcoat
+};
+
+View make_view(Lobes s, vec3 v) {
+    View view;
+    view.v = v;
+    view.v_stretched = normalize(vec3(s.ax * v.x, s.ay * v.y, v.z));
+    view.fv = schlick_weight(v.z);
+    view.g_spec = smith_g_aniso(v, s.ax, s.ay);
+    view.g_coat = smith_g_clearcoat(v.z);
+    return view;
+}
+
+// The half vector of a pair of directions and the two microfacet distributions at it.
+struct HalfVector {
+    vec3 h;        // normalize(l + v), or 0 when l = −v
+    float d_spec;  // GGX D(h)
+    float d_coat;  // GTR1 D(h)
+};
+
+HalfVector make_half_vector(Lobes s, vec3 l, vec3 v) {
+    HalfVector hv;
+    vec3 sum = l + v;
+    float len2 = dot(sum, sum);
+    hv.h = len2 > 0.0 ? sum * inversesqrt(len2) : vec3(0.0);
+    hv.d_spec = len2 > 0.0 ? gtr2_aniso(hv.h, s.ax, s.ay) : 0.0;
+    hv.d_coat = len2 > 0.0 ? gtr1(hv.h, s.cc_alpha2, s.cc_norm) : 0.0;
+    return hv;
+}
+
 // f(l, v), without the cosine. Zero unless both directions are above the surface, which also
 // avoids the reference code's 0/0 when both are at grazing.
-vec3 disney_brdf(Lobes s, vec3 l, vec3 v) {
+vec3 disney_brdf(Lobes s, View view, vec3 l, HalfVector hv) {
     float cl = l.z;
-    float cv = v.z;
+    float cv = view.v.z;
     if (cl <= 0.0 || cv <= 0.0) {
         return vec3(0.0);
     }
-    vec3 h = normalize(l + v);
-    float cd = dot(l, h);
+    float cd = dot(l, hv.h);
     float fl = schlick_weight(cl);
-    float fv = schlick_weight(cv);
     float fh = schlick_weight(cd);
 
     // Diffuse: Schlick-style retro-reflection, and the Hanrahan–Krueger-like subsurface.
     float cd2r = cd * cd * s.roughness;
     float fd90 = 0.5 + 2.0 * cd2r;
-    float fd = mix(1.0, fd90, fl) * mix(1.0, fd90, fv);
-    float fss = mix(1.0, cd2r, fl) * mix(1.0, cd2r, fv);
+    float fd = mix(1.0, fd90, fl) * mix(1.0, fd90, view.fv);
+    float fss = mix(1.0, cd2r, fl) * mix(1.0, cd2r, view.fv);
     float ss = 1.25 * (fss * (1.0 / (cl + cv) - 0.5) + 0.5);
     vec3 diffuse = (INV_PI * mix(fd, ss, s.subsurface)) * s.base_color + fh * s.sheen_color;
 
     // Specular: anisotropic GGX.
     vec3 fs = mix(s.cspec0, vec3(1.0), fh);
-    float ds = gtr2_aniso(h, s.ax, s.ay);
-    float gs = smith_g_aniso(l, s.ax, s.ay) * smith_g_aniso(v, s.ax, s.ay);
+    float gs = smith_g_aniso(l, s.ax, s.ay) * view.g_spec;
 
     // Clearcoat: GTR1 with a fixed IOR 1.5.
-    float dr = gtr1(h, s.cc_alpha2, s.cc_norm);
     float fr = mix(0.04, 1.0, fh);
-    float gr = smith_g_clearcoat(cl) * smith_g_clearcoat(cv);
+    float gr = smith_g_clearcoat(cl) * view.g_coat;
 
-    return diffuse * (1.0 - s.metallic) + (gs * ds) * fs + vec3(s.clearcoat * gr * fr * dr);
+    return diffuse * (1.0 - s.metallic) + (gs * hv.d_spec) * fs + vec3(s.clearcoat * gr * fr * hv.d_coat);
 }
 
 #endif

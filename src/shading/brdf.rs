@@ -24,6 +24,8 @@ pub struct Lobes {
     pub clearcoat: f32,
     /// GTR1 alpha², at most 1.
     pub cc_alpha2: f32,
+    /// For sampling GTR1.
+    pub cc_log2_alpha2: f32,
     /// GTR1 normalisation (α²−1)/(π·ln α²), or 1/π when α ≥ 1.
     pub cc_norm: f32,
 }
@@ -62,6 +64,7 @@ pub fn make_lobes(m: &Params) -> Lobes {
         ay: (r2 * aspect).max(0.001),
         clearcoat: 0.25 * m.clearcoat,
         cc_alpha2,
+        cc_log2_alpha2: cc_alpha2.log2(),
         cc_norm: gtr1_norm(cc_alpha2),
     }
 }
@@ -100,36 +103,84 @@ pub fn smith_g_clearcoat(cos_w: f32) -> f32 {
     1.0 / (cos_w + (0.0625 + c2 - 0.0625 * c2).sqrt())
 }
 
+/// What depends only on the view direction, derived once per pixel.
+#[derive(Clone, Copy, Debug)]
+pub struct View {
+    pub v: Vec3,
+    /// `v` in the GGX hemisphere configuration, for visible-normal sampling.
+    pub v_stretched: Vec3,
+    /// S(N·V).
+    pub fv: f32,
+    /// g(V) of the specular lobe.
+    pub g_spec: f32,
+    /// g25(V) of the clearcoat.
+    pub g_coat: f32,
+}
+
+pub fn make_view(s: &Lobes, v: Vec3) -> View {
+    View {
+        v,
+        v_stretched: Vec3::new(s.ax * v.x, s.ay * v.y, v.z).normalize(),
+        fv: schlick_weight(v.z),
+        g_spec: smith_g_aniso(v, s.ax, s.ay),
+        g_coat: smith_g_clearcoat(v.z),
+    }
+}
+
+/// The half vector of a pair of directions and the two microfacet distributions at it.
+#[derive(Clone, Copy, Debug)]
+pub struct HalfVector {
+    /// normalize(l + v), or 0 when l = −v.
+    pub h: Vec3,
+    /// GGX D(h).
+    pub d_spec: f32,
+    /// GTR1 D(h).
+    pub d_coat: f32,
+}
+
+pub fn make_half_vector(s: &Lobes, l: Vec3, v: Vec3) -> HalfVector {
+    let sum = l + v;
+    let len2 = sum.dot(sum);
+    if len2 > 0.0 {
+        let h = sum / len2.sqrt();
+        HalfVector { h, d_spec: gtr2_aniso(h, s.ax, s.ay), d_coat: gtr1(h, s.cc_alpha2, s.cc_norm) }
+    } else {
+        HalfVector { h: Vec3::ZERO, d_spec: 0.0, d_coat: 0.0 }
+    }
+}
+
 /// f(l, v), without the cosine; zero unless both directions are above the surface.
-pub fn disney_brdf(s: &Lobes, l: Vec3, v: Vec3) -> Vec3 {
+pub fn disney_brdf(s: &Lobes, view: &View, l: Vec3, hv: &HalfVector) -> Vec3 {
     let cl = l.z;
-    let cv = v.z;
+    let cv = view.v.z;
     if cl <= 0.0 || cv <= 0.0 {
         return Vec3::ZERO;
     }
-    let h = (l + v).normalize();
-    let cd = l.dot(h);
+    let cd = l.dot(hv.h);
     let fl = schlick_weight(cl);
-    let fv = schlick_weight(cv);
     let fh = schlick_weight(cd);
 
     // Diffuse: Schlick-style retro-reflection, and the Hanrahan–Krueger-like subsurface.
     let cd2r = cd * cd * s.roughness;
     let fd90 = 0.5 + 2.0 * cd2r;
-    let fd = mix(1.0, fd90, fl) * mix(1.0, fd90, fv);
-    let fss = mix(1.0, cd2r, fl) * mix(1.0, cd2r, fv);
+    let fd = mix(1.0, fd90, fl) * mix(1.0, fd90, view.fv);
+    let fss = mix(1.0, cd2r, fl) * mix(1.0, cd2r, view.fv);
     let ss = 1.25 * (fss * (1.0 / (cl + cv) - 0.5) + 0.5);
     let diffuse = (INV_PI * mix(fd, ss, s.subsurface)) * s.base_color + fh * s.sheen_color;
 
     // Specular: anisotropic GGX.
     let fs = s.cspec0.lerp(Vec3::ONE, fh);
-    let ds = gtr2_aniso(h, s.ax, s.ay);
-    let gs = smith_g_aniso(l, s.ax, s.ay) * smith_g_aniso(v, s.ax, s.ay);
+    let gs = smith_g_aniso(l, s.ax, s.ay) * view.g_spec;
 
     // Clearcoat: GTR1 with a fixed IOR 1.5.
-    let dr = gtr1(h, s.cc_alpha2, s.cc_norm);
     let fr = mix(0.04, 1.0, fh);
-    let gr = smith_g_clearcoat(cl) * smith_g_clearcoat(cv);
+    let gr = smith_g_clearcoat(cl) * view.g_coat;
 
-    diffuse * (1.0 - s.metallic) + (gs * ds) * fs + Vec3::splat(s.clearcoat * gr * fr * dr)
+    diffuse * (1.0 - s.metallic) + (gs * hv.d_spec) * fs + Vec3::splat(s.clearcoat * gr * fr * hv.d_coat)
+}
+
+/// f(l, v) for a material, from scratch: what the per-pixel and per-pair steps compute together.
+pub fn evaluate(params: &Params, l: Vec3, v: Vec3) -> Vec3 {
+    let s = make_lobes(params);
+    disney_brdf(&s, &make_view(&s, v), l, &make_half_vector(&s, l, v))
 }

@@ -1,7 +1,7 @@
 //! Mirror of `glsl/include/sampling.glsl`: BRDF importance sampling and MIS.
 
-use super::brdf::{gtr1, gtr2_aniso, schlick_weight, smith_g_aniso, Lobes};
-use super::common::{luminance, mix, INV_PI, ONE_MINUS_EPSILON, PI, TWO_PI};
+use super::brdf::{HalfVector, Lobes, View};
+use super::common::{luminance, mix, INV_PI, ONE_MINUS_EPSILON, TWO_PI};
 use glam::{Vec2, Vec3};
 
 /// Probabilities of picking each lobe for one-sample MIS; they sum to 1.
@@ -16,11 +16,10 @@ pub struct LobeChoice {
 }
 
 /// Picks lobes in proportion to an estimate of their reflectance at this view angle.
-pub fn choose_lobes(s: &Lobes, cos_v: f32) -> LobeChoice {
-    let fv = schlick_weight(cos_v);
+pub fn choose_lobes(s: &Lobes, view: &View) -> LobeChoice {
     let w_diffuse = (1.0 - s.metallic) * (luminance(s.base_color) + 0.25 * luminance(s.sheen_color));
-    let w_specular = luminance(s.cspec0.lerp(Vec3::ONE, fv));
-    let w_clearcoat = s.clearcoat * mix(0.04, 1.0, fv);
+    let w_specular = luminance(s.cspec0.lerp(Vec3::ONE, view.fv));
+    let w_clearcoat = s.clearcoat * mix(0.04, 1.0, view.fv);
     let total = w_diffuse + w_specular + w_clearcoat;
     if !(total > 0.0) {
         return LobeChoice { diffuse: 1.0, specular: 0.0, clearcoat: 0.0 };
@@ -28,78 +27,64 @@ pub fn choose_lobes(s: &Lobes, cos_v: f32) -> LobeChoice {
     LobeChoice { diffuse: w_diffuse / total, specular: w_specular / total, clearcoat: w_clearcoat / total }
 }
 
-/// Cosine-weighted hemisphere, by Shirley and Chiu's concentric disk mapping.
-pub fn sample_cosine(u: Vec2) -> Vec3 {
-    let d = 2.0 * u - Vec2::ONE;
-    if d.x == 0.0 && d.y == 0.0 {
-        return Vec3::Z;
-    }
-    let (r, phi) = if d.x.abs() > d.y.abs() {
-        (d.x, (PI / 4.0) * (d.y / d.x))
-    } else {
-        (d.y, (PI / 2.0) - (PI / 4.0) * (d.x / d.y))
-    };
-    let z = (1.0 - r * r).max(0.0).sqrt();
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+/// (cos φ, sin φ) for φ = 2π·x.
+pub fn azimuth(x: f32) -> Vec2 {
+    let phi = TWO_PI * x;
+    Vec2::new(phi.cos(), phi.sin())
+}
+
+/// Cosine-weighted hemisphere: a uniform disk (r = √u) lifted to the hemisphere.
+pub fn sample_cosine(azimuth: Vec2, u: f32) -> Vec3 {
+    let r = u.sqrt();
+    (r * azimuth).extend((1.0 - u).max(0.0).sqrt())
 }
 
 pub fn pdf_cosine(l: Vec3) -> f32 {
     l.z.max(0.0) * INV_PI
 }
 
-/// A GGX microfacet normal visible from `v`, by Dupuy and Benyoub's spherical caps (2023).
-pub fn sample_ggx_visible_normal(v: Vec3, ax: f32, ay: f32, u: Vec2) -> Vec3 {
-    let vh = Vec3::new(ax * v.x, ay * v.y, v.z).normalize();
-    let phi = TWO_PI * u.x;
-    let z = (1.0 - u.y) * (1.0 + vh.z) - vh.z;
+/// A GGX microfacet normal visible from v, by Dupuy and Benyoub's spherical caps (2023).
+pub fn sample_ggx_visible_normal(v_stretched: Vec3, ax: f32, ay: f32, azimuth: Vec2, u: f32) -> Vec3 {
+    let z = (1.0 - u) * (1.0 + v_stretched.z) - v_stretched.z;
     let sin_theta = (1.0 - z * z).clamp(0.0, 1.0).sqrt();
-    let hh = Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), z) + vh;
-    Vec3::new(ax * hh.x, ay * hh.y, hh.z).normalize()
+    let h = (sin_theta * azimuth).extend(z) + v_stretched;
+    Vec3::new(ax * h.x, ay * h.y, h.z).normalize()
 }
 
-/// pdf of l = reflect(−v, h) for visible-normal sampling: G1(v)·D(h)/(4·N·v) = g(v)·D(h)/2.
-pub fn pdf_ggx_reflection(v: Vec3, h: Vec3, ax: f32, ay: f32) -> f32 {
-    if h.z > 0.0 {
-        0.5 * smith_g_aniso(v, ax, ay) * gtr2_aniso(h, ax, ay)
+/// pdf of l = reflect(−v, h) for visible-normal sampling: g(v)·D(h)/2.
+pub fn pdf_ggx_reflection(view: &View, hv: &HalfVector) -> f32 {
+    if hv.h.z > 0.0 {
+        0.5 * view.g_spec * hv.d_spec
     } else {
         0.0
     }
 }
 
 /// A GTR1 half vector (Burley 2012, appendix B): cos²θh = (1 − α^(2(1−u)))/(1 − α²).
-pub fn sample_gtr1_normal(alpha2: f32, u: Vec2) -> Vec3 {
-    let phi = TWO_PI * u.x;
-    let cos2 = if alpha2 >= 1.0 { 1.0 - u.y } else { (1.0 - alpha2.powf(1.0 - u.y)) / (1.0 - alpha2) };
+pub fn sample_gtr1_normal(alpha2: f32, log2_alpha2: f32, azimuth: Vec2, u: f32) -> Vec3 {
+    let cos2 = if alpha2 >= 1.0 { 1.0 - u } else { (1.0 - (log2_alpha2 * (1.0 - u)).exp2()) / (1.0 - alpha2) };
     let cos2 = cos2.clamp(0.0, 1.0);
-    let sin_theta = (1.0 - cos2).sqrt();
-    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos2.sqrt())
+    ((1.0 - cos2).sqrt() * azimuth).extend(cos2.sqrt())
 }
 
-/// pdf of l = reflect(−v, h) for GTR1 half-vector sampling: D(h)·(N·h)/(4·|v·h|), with h taken
-/// in the upper hemisphere (see the GLSL for why).
-pub fn pdf_gtr1_reflection(v: Vec3, h: Vec3, alpha2: f32, norm: f32) -> f32 {
-    let h = if h.z < 0.0 { -h } else { h };
-    let vh = v.dot(h).abs();
+/// pdf of l = reflect(−v, h) for GTR1 half-vector sampling: D(h)·|N·h|/(4·|v·h|).
+pub fn pdf_gtr1_reflection(view: &View, hv: &HalfVector) -> f32 {
+    let vh = view.v.dot(hv.h).abs();
     if vh > 0.0 {
-        gtr1(h, alpha2, norm) * h.z / (4.0 * vh)
+        hv.d_coat * hv.h.z.abs() / (4.0 * vh)
     } else {
         0.0
     }
 }
 
 /// The one-sample MIS pdf of [`sample_brdf`]: Σ pᵢ·pdfᵢ(l).
-pub fn brdf_pdf(s: &Lobes, c: &LobeChoice, l: Vec3, v: Vec3) -> f32 {
-    let sum = l + v;
-    let len2 = sum.dot(sum);
+pub fn brdf_pdf(c: &LobeChoice, view: &View, l: Vec3, hv: &HalfVector) -> f32 {
     let mut pdf = c.diffuse * pdf_cosine(l);
-    if len2 > 0.0 {
-        let h = sum / len2.sqrt();
-        if c.specular > 0.0 {
-            pdf += c.specular * pdf_ggx_reflection(v, h, s.ax, s.ay);
-        }
-        if c.clearcoat > 0.0 {
-            pdf += c.clearcoat * pdf_gtr1_reflection(v, h, s.cc_alpha2, s.cc_norm);
-        }
+    if c.specular > 0.0 {
+        pdf += c.specular * pdf_ggx_reflection(view, hv);
+    }
+    if c.clearcoat > 0.0 {
+        pdf += c.clearcoat * pdf_gtr1_reflection(view, hv);
     }
     pdf
 }
@@ -109,21 +94,25 @@ pub fn reflect(i: Vec3, n: Vec3) -> Vec3 {
     i - 2.0 * n.dot(i) * n
 }
 
-/// Picks a lobe with u.x, then reuses u.x, rescaled to [0, 1), for that lobe's own sample.
-pub fn sample_brdf(s: &Lobes, c: &LobeChoice, v: Vec3, mut u: Vec2) -> Vec3 {
-    if u.x < c.diffuse {
-        u.x = (u.x / c.diffuse).min(ONE_MINUS_EPSILON);
-        return sample_cosine(u);
+/// Picks a lobe with u.x, then reuses u.x, rescaled to [0, 1), for the azimuth.
+pub fn sample_brdf(s: &Lobes, c: &LobeChoice, view: &View, u: Vec2) -> Vec3 {
+    let (lobe, x) = if u.x < c.diffuse {
+        (0, u.x / c.diffuse)
+    } else if u.x < c.diffuse + c.specular || c.clearcoat <= 0.0 {
+        (1, (u.x - c.diffuse) / c.specular)
+    } else {
+        (2, (u.x - c.diffuse - c.specular) / c.clearcoat)
+    };
+    let phi = azimuth(x.min(ONE_MINUS_EPSILON));
+    if lobe == 0 {
+        return sample_cosine(phi, u.y);
     }
-    u.x -= c.diffuse;
-    if u.x < c.specular || c.clearcoat <= 0.0 {
-        u.x = (u.x / c.specular).min(ONE_MINUS_EPSILON);
-        let h = sample_ggx_visible_normal(v, s.ax, s.ay, u);
-        return reflect(-v, h);
-    }
-    u.x = ((u.x - c.specular) / c.clearcoat).min(ONE_MINUS_EPSILON);
-    let h = sample_gtr1_normal(s.cc_alpha2, u);
-    reflect(-v, h)
+    let h = if lobe == 1 {
+        sample_ggx_visible_normal(view.v_stretched, s.ax, s.ay, phi, u.y)
+    } else {
+        sample_gtr1_normal(s.cc_alpha2, s.cc_log2_alpha2, phi, u.y)
+    };
+    reflect(-view.v, h)
 }
 
 /// The power heuristic (β = 2) for one sample from each of two techniques, divided by the

@@ -8,7 +8,7 @@
 
 use glam::Vec3;
 use lookdev::material::Params;
-use lookdev::shading::brdf::{disney_brdf, make_lobes};
+use lookdev::shading::brdf::{disney_brdf, make_half_vector, make_lobes, make_view};
 use std::f64::consts::PI;
 
 struct Density {
@@ -74,6 +74,7 @@ pub fn directional_albedo_at(params: &Params, v: [f64; 3]) -> [f64; 3] {
         Density { alpha_ggx: ((lobes.ax as f64) * (lobes.ay as f64)).sqrt(), alpha2_gtr1: (a * a).min(0.999_999) };
     let (n_u, n_phi) = (384usize, 384usize);
     let vf = Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32);
+    let view = make_view(&lobes, vf);
     let mut sum = [0.0f64; 3];
     for technique in 0..3 {
         for i in 0..n_u {
@@ -103,7 +104,7 @@ pub fn directional_albedo_at(params: &Params, v: [f64; 3]) -> [f64; 3] {
                     continue;
                 }
                 let lf = Vec3::new(l[0] as f32, l[1] as f32, l[2] as f32).normalize();
-                let f = disney_brdf(&lobes, lf, vf);
+                let f = disney_brdf(&lobes, &view, lf, &make_half_vector(&lobes, lf, vf));
                 // Balance heuristic: f·cos·(own/total)/own = f·cos/total.
                 let weight = l[2] / total / (n_u * n_phi) as f64;
                 for c in 0..3 {
