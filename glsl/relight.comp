@@ -43,16 +43,14 @@ vec3 to_environment(vec3 d) {
 vec3 estimate(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, vec2 u_env, vec2 u_brdf) {
     vec3 result = vec3(0.0);
 
-    vec2 uv;
     vec4 texel;
-    vec3 d = env_sample(u_env, uv, texel);
+    vec3 d = env_sample(u_env, texel);
     vec3 l = vec3(dot(d, fx), dot(d, fy), dot(d, fn));
-    float pdf_env = env_pdf(texel.a, d);
-    if (l.z > 0.0 && pdf_env > 0.0) {
+    if (l.z > 0.0 && texel.a > 0.0) {
         HalfVector hv = make_half_vector(s, l, view.v);
         vec3 f = disney_brdf(s, view, l, hv);
         float pdf_brdf = brdf_pdf(choice, view, l, hv);
-        result += f * (l.z * mis_weight_over_pdf(pdf_env, pdf_brdf)) * texel.rgb;
+        result += f * (l.z * mis_weight_over_pdf(texel.a, pdf_brdf)) * texel.rgb;
     }
 
     l = sample_brdf(s, choice, view, u_brdf);
@@ -63,7 +61,7 @@ vec3 estimate(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, 
             d = normalize(l.x * fx + l.y * fy + l.z * fn);
             texel = env_texel(env_direction_to_uv(d));
             vec3 f = disney_brdf(s, view, l, hv);
-            result += f * (l.z * mis_weight_over_pdf(pdf_brdf, env_pdf(texel.a, d))) * texel.rgb;
+            result += f * (l.z * mis_weight_over_pdf(pdf_brdf, texel.a)) * texel.rgb;
         }
     }
     return result * pass.intensity;

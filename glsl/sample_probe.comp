@@ -56,13 +56,11 @@ void main() {
         vec3 l = sample_brdf(s, choice, v, u);
         result = vec4(l, brdf_pdf(choice, v, l, make_half_vector(s, l, v.v)));
     } else if (routine == ROUTINE_ENVIRONMENT) {
-        vec2 uv;
         vec4 texel;
-        vec3 d = env_sample(u, uv, texel);
-        float pdf = env_pdf(texel.a, d);
+        vec3 d = env_sample(u, texel);
         // Also check that looking the pdf up from the direction agrees with the sampler's own.
-        float looked_up = env_pdf(env_texel(env_direction_to_uv(d)).a, d);
-        result = vec4(d, abs(looked_up - pdf) <= 1e-3 * pdf ? pdf : -1.0);
+        float looked_up = env_texel(env_direction_to_uv(d)).a;
+        result = vec4(d, abs(looked_up - texel.a) <= 1e-3 * texel.a ? texel.a : -1.0);
     } else if (routine == ROUTINE_SOBOL) {
         result = vec4(sobol_owen_2d(i, seed), 0.0, 0.0);
     } else {

@@ -8,6 +8,7 @@ mod common;
 use common::random::Random;
 use common::stats::chi_square;
 use glam::{Vec2, Vec3};
+use lookdev::environment::distribution::row_cos;
 use lookdev::environment::{self, Distribution, Environment, GpuEnvironment};
 use lookdev::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context};
 use lookdev::material::Params;
@@ -273,11 +274,8 @@ fn check_environment_cells(env: &Environment, distribution: &Distribution, sampl
     let (nx, ny) = (cols.div_ceil(bx) as usize, rows.div_ceil(by) as usize);
     let mut expected = vec![0.0; nx * ny];
     for row in 0..rows {
-        let (y0, y1) = distribution.cell_span(row, distribution.height);
         for column in 0..cols {
-            let (x0, x1) = distribution.cell_span(column, distribution.width);
-            let area = ((x1 - x0) * (y1 - y0)) as f64 / (distribution.width * distribution.height) as f64;
-            let p = distribution.cell_pdf[(row * cols + column) as usize] as f64 * area;
+            let p = distribution.cell_pdf[(row * cols + column) as usize] as f64 * distribution.cell_solid_angle(row, column);
             expected[(row / by) as usize * nx + (column / bx) as usize] += p * samples.len() as f64;
         }
     }
@@ -286,13 +284,14 @@ fn check_environment_cells(env: &Environment, distribution: &Distribution, sampl
     for (d, _) in samples {
         let uv = environment::sampling::direction_to_uv(*d);
         let texel = environment::sampling::texel_of(distribution.width, distribution.height, uv);
-        let (cx, cy) = (texel.x / distribution.block, texel.y / distribution.block);
+        let (cx, cy) = (texel.x / distribution.block_x, texel.y / distribution.block_y);
         observed[(cy / by) as usize * nx + (cx / bx) as usize] += 1.0;
-        // Where the sample lies inside its cell, in [0, 1)².
-        let (x0, x1) = distribution.cell_span(cx, distribution.width);
-        let (y0, y1) = distribution.cell_span(cy, distribution.height);
-        let p = uv * Vec2::new(distribution.width as f32, distribution.height as f32);
-        let (fx, fy) = ((p.x - x0 as f32) / (x1 - x0) as f32, (p.y - y0 as f32) / (y1 - y0) as f32);
+        // Where the sample lies inside its cell, uniform in azimuth and in cos θ: [0, 1)².
+        let (x0, x1) = Distribution::span(cx, distribution.block_x, distribution.width);
+        let (y0, y1) = Distribution::span(cy, distribution.block_y, distribution.height);
+        let fx = (uv.x * distribution.width as f32 - x0 as f32) / (x1 - x0) as f32;
+        let (z0, z1) = (row_cos(y0, distribution.height), row_cos(y1, distribution.height));
+        let fy = ((d.y as f64 - z0) / (z1 - z0)) as f32;
         inside[((fy * 8.0).max(0.0) as usize).min(7) * 8 + ((fx * 8.0).max(0.0) as usize).min(7)] += 1.0;
     }
     assert_chi_square(&format!("{name}, cells"), &observed, &expected);
@@ -312,8 +311,8 @@ fn environment_sampling_matches_its_pdf() {
     }
     // Maps wider than the cell grid use blocks of texels, with smaller blocks at the edges.
     let env = sun_and_sky(301, 150);
-    let blocked = Distribution::with_max_columns(&env, 64);
-    assert_eq!((blocked.block, blocked.columns, blocked.rows), (5, 61, 30));
+    let blocked = Distribution::with_max_cells(&env, 64);
+    assert_eq!((blocked.block_x, blocked.block_y, blocked.columns, blocked.rows), (5, 3, 61, 50));
     let samples = probe.run_with(ENVIRONMENT, &Params::default(), Vec3::Z, 0, &uniforms(SAMPLES, 300), &env, &blocked);
     check_environment_cells(&env, &blocked, &samples);
 
@@ -339,8 +338,7 @@ fn environment_sampling_matches_its_pdf() {
 }
 
 fn pdf_of(distribution: &Distribution, d: Vec3) -> f64 {
-    let d = d.normalize();
-    distribution.pdf(environment::sampling::direction_to_uv(d), d) as f64
+    distribution.pdf(environment::sampling::direction_to_uv(d.normalize())) as f64
 }
 
 /// ∫ f over the sphere by a fine midpoint rule, uniform in cosθ and φ about +Y.
@@ -381,9 +379,9 @@ fn the_reference_samplers_match_their_pdfs_too() {
     let samples: Vec<(Vec3, f32)> = uniforms(1 << 18, 78)
         .into_iter()
         .map(|u| {
-            let (d, _, texel) = distribution.sample(u);
-            let pdf = distribution.sample_pdf(d, texel);
-            let looked_up = distribution.pdf(environment::sampling::direction_to_uv(d), d);
+            let (d, texel) = distribution.sample(u);
+            let pdf = distribution.texel_cell_pdf(texel);
+            let looked_up = distribution.pdf(environment::sampling::direction_to_uv(d));
             (d, if (looked_up - pdf).abs() <= 1e-3 * pdf { pdf } else { -1.0 })
         })
         .collect();

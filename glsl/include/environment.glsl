@@ -2,38 +2,28 @@
 //
 // Directions here are in environment space: the world direction rotated by R_y(−rotation).
 // u = 0.5 + atan2(d.x, −d.z)/2π (wrapped into [0, 1)), v = acos(d.y)/π, row 0 the zenith.
-// Lighting treats the map as piecewise constant over its texels, which is exactly the function
-// the sampling distribution is built from (cells of whole texels, weighted by luminance·sinθ), so
-// one texel fetch gives both the radiance and the pdf. Only the background, which is seen
-// directly, is filtered bilinearly. pdf_ω = pdf_uv/(2π²·sinθ). Descriptor set 1 holds the
-// environment for every kernel that needs it. Mirrored in src/environment/sampling.rs.
+// Lighting treats the map as piecewise constant over its texels; sampling draws from a density
+// that is piecewise constant in solid angle over cells of whole texels, so each texel stores its
+// cell's pdf_ω beside its radiance and one fetch gives both. Only the background, which is seen
+// directly, is filtered bilinearly. Descriptor set 1 holds the environment for every kernel that
+// needs it. Mirrored in src/environment/sampling.rs; the tables are built in distribution.rs.
 #ifndef LOOKDEV_ENVIRONMENT_GLSL
 #define LOOKDEV_ENVIRONMENT_GLSL
 
 #include "common.glsl"
 
-// rgb: radiance; a: pdf_uv of the sampling cell that holds the texel.
+// rgb: radiance; a: pdf over solid angle of the sampling cell that holds the texel.
 layout(set = 1, binding = 0, rgba32f) uniform readonly image2D env_texels;
-// The marginal CDF over rows of cells: env_marginal_cdf[0] = 0, env_marginal_cdf[rows] = 1.
-layout(set = 1, binding = 1, std430) readonly buffer EnvMarginal {
+// Inverse-CDF tables: row 0 over rows of cells, row 1 + r over the cells of row r. Texel i of a
+// table of n intervals is (cdf[i], cdf[i + 1], guide[i], guide[i + 1]).
+layout(set = 1, binding = 1, rgba32f) uniform readonly image2D env_tables;
+layout(set = 1, binding = 2, std430) readonly buffer EnvInfo {
     uint env_width;    // texels
     uint env_height;
-    uint env_block;    // texels per cell side
+    uint env_block_x;  // texels per cell
+    uint env_block_y;
     uint env_columns;  // cells
     uint env_rows;
-    uint env_pad0;
-    uint env_pad1;
-    uint env_pad2;
-    float env_marginal_cdf[];
-};
-// One conditional CDF over columns per row of cells, each with columns + 1 entries.
-layout(set = 1, binding = 2, std430) readonly buffer EnvConditional {
-    float env_conditional_cdf[];
-};
-// Guide tables: rows + 1 entries for the marginal, then columns + 1 per row. guide[k] is the
-// last interval whose CDF value is at most k/n, so a search only spans the buckets around u.
-layout(set = 1, binding = 3, std430) readonly buffer EnvGuides {
-    uint env_guides[];
 };
 
 // v = acos(d.y)/π, computed as atan2(|d.xz|, d.y)/π: the same angle for a unit d, but well
@@ -45,23 +35,21 @@ vec2 env_direction_to_uv(vec3 d) {
     return vec2(u, v);
 }
 
-vec3 env_uv_to_direction(vec2 uv) {
-    float phi = TWO_PI * (uv.x - 0.5);
-    float theta = PI * uv.y;
-    float sin_theta = sin(theta);
-    return vec3(sin_theta * sin(phi), cos(theta), -sin_theta * cos(phi));
+// The direction with azimuth u and polar angle θ given by its cosine and sine.
+vec3 env_direction(float u, float cos_theta, float sin_theta) {
+    float phi = TWO_PI * (u - 0.5);
+    return vec3(sin_theta * sin(phi), cos_theta, -sin_theta * cos(phi));
 }
 
-// The texel holding uv: its radiance (rgb) and its cell's pdf_uv (a).
+vec3 env_uv_to_direction(vec2 uv) {
+    float theta = PI * uv.y;
+    return env_direction(uv.x, cos(theta), sin(theta));
+}
+
+// The texel holding uv: its radiance (rgb) and its cell's pdf_ω (a).
 vec4 env_texel(vec2 uv) {
     ivec2 size = ivec2(env_width, env_height);
     return imageLoad(env_texels, min(ivec2(uv * vec2(size)), size - 1));
-}
-
-// pdf over solid angle, from pdf_uv, at a direction d (unit, environment space).
-float env_pdf(float pdf_uv, vec3 d) {
-    float sin_theta = sqrt(max(0.0, 1.0 - d.y * d.y));
-    return sin_theta > 0.0 ? pdf_uv / (2.0 * PI * PI * sin_theta) : 0.0;
 }
 
 // Bilinear radiance between texel centres, wrapping in u and clamping in v: for the background.
@@ -83,60 +71,52 @@ vec3 env_background(vec2 uv) {
     return mix(mix(a, b, t.x), mix(c, d, t.x), t.y);
 }
 
-// Last row r with marginal_cdf[r] <= u. The guides bound the binary search; taking the buckets
-// either side of u's keeps it right even if u·rows rounds into a neighbouring bucket.
-uint env_search_rows(float u) {
-    int k = int(u * float(env_rows));
-    uint lo = env_guides[max(k - 1, 0)];
-    uint hi = min(env_guides[min(k + 2, int(env_rows))] + 1u, env_rows);
+// The last interval r of table `table` (n intervals) with cdf[r] <= u, and (cdf[r], cdf[r + 1]).
+// u's bucket's guides bound the answer, usually to a single interval.
+uint env_search(uint table, uint n, float u, out vec2 bounds) {
+    uint k = min(uint(u * float(n)), n - 1u);
+    vec4 entry = imageLoad(env_tables, ivec2(k, table));
+    uint lo = uint(entry.z);
+    uint hi = uint(entry.w) + 1u;
     while (hi - lo > 1u) {
         uint mid = (lo + hi) >> 1;
-        if (env_marginal_cdf[mid] <= u) {
+        if (imageLoad(env_tables, ivec2(mid, table)).x <= u) {
             lo = mid;
         } else {
             hi = mid;
         }
     }
+    bounds = imageLoad(env_tables, ivec2(lo, table)).xy;
     return lo;
 }
 
-uint env_search_columns(uint row, float u) {
-    uint base = row * (env_columns + 1u);
-    uint guides = env_rows + 1u + base;
-    int k = int(u * float(env_columns));
-    uint lo = env_guides[guides + uint(max(k - 1, 0))];
-    uint hi = min(env_guides[guides + uint(min(k + 2, int(env_columns)))] + 1u, env_columns);
-    while (hi - lo > 1u) {
-        uint mid = (lo + hi) >> 1;
-        if (env_conditional_cdf[base + mid] <= u) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    return lo;
+// cos θ at the top edge of texel row y.
+float env_row_cos(uint y) {
+    return cos(PI * float(y) / float(env_height));
 }
 
-// Samples a direction in proportion to the distribution. Returns it with its uv and its texel
-// (radiance and pdf_uv), fetched from the texel the sample lies in.
-vec3 env_sample(vec2 u, out vec2 uv, out vec4 texel) {
-    uint row = env_search_rows(u.y);
-    float r0 = env_marginal_cdf[row];
-    float r1 = env_marginal_cdf[row + 1u];
-    float dv = r1 > r0 ? (u.y - r0) / (r1 - r0) : 0.5;
+// Samples a direction in proportion to the distribution: a cell by the tables, then a point
+// uniform in solid angle within it (uniform in azimuth and in cos θ). Returns the direction and
+// its texel: radiance and pdf_ω.
+vec3 env_sample(vec2 u, out vec4 texel) {
+    vec2 bounds;
+    uint row = env_search(0u, env_rows, u.y, bounds);
+    float dv = bounds.y > bounds.x ? (u.y - bounds.x) / (bounds.y - bounds.x) : 0.5;
+    uint column = env_search(1u + row, env_columns, u.x, bounds);
+    float du = bounds.y > bounds.x ? (u.x - bounds.x) / (bounds.y - bounds.x) : 0.5;
+    du = min(du, ONE_MINUS_EPSILON);
+    dv = min(dv, ONE_MINUS_EPSILON);
 
-    uint column = env_search_columns(row, u.x);
-    uint base = row * (env_columns + 1u);
-    float c0 = env_conditional_cdf[base + column];
-    float c1 = env_conditional_cdf[base + column + 1u];
-    float du = c1 > c0 ? (u.x - c0) / (c1 - c0) : 0.5;
-
-    uvec2 start = uvec2(column, row) * env_block;
-    uvec2 end = min(start + env_block, uvec2(env_width, env_height));
-    vec2 position = vec2(start) + min(vec2(du, dv), vec2(ONE_MINUS_EPSILON)) * vec2(end - start);
-    uv = position / vec2(env_width, env_height);
-    texel = imageLoad(env_texels, ivec2(min(uvec2(position), end - 1u)));
-    return env_uv_to_direction(uv);
+    uvec2 start = uvec2(column * env_block_x, row * env_block_y);
+    uvec2 end = min(start + uvec2(env_block_x, env_block_y), uvec2(env_width, env_height));
+    float x = float(start.x) + du * float(end.x - start.x);
+    float z = mix(env_row_cos(start.y), env_row_cos(end.y), dv);
+    float sin_theta = sqrt(max(0.0, 1.0 - z * z));
+    // With one texel row per cell the row is known; otherwise find it from the angle.
+    uint y = env_block_y == 1u ? start.y
+                               : clamp(uint(atan(sin_theta, z) * INV_PI * float(env_height)), start.y, end.y - 1u);
+    texel = imageLoad(env_texels, ivec2(min(uint(x), end.x - 1u), y));
+    return env_direction(x / float(env_width), z, sin_theta);
 }
 
 #endif

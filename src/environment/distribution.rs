@@ -1,20 +1,25 @@
-//! The environment's importance-sampling tables (LOOKDEV.md §5): a piecewise-constant density
-//! over cells of texels, weighted by luminance·sinθ, as a marginal CDF over rows of cells and one
-//! conditional CDF per row, each with a guide table. Built once per map; rotation only rotates
-//! directions.
+//! The environment's importance-sampling tables (LOOKDEV.md §5).
 //!
-//! Cells are single texels up to [`MAX_COLUMNS`] texels wide; wider maps use square blocks of
-//! texels (the last block in a row or column may be smaller). Keeping every cell a whole number
-//! of texels means each texel lies in exactly one cell, so the GPU stores each cell's pdf beside
-//! the texel's radiance and one fetch gives both.
+//! Lighting treats the map as piecewise constant over its texels, and sampling draws directions
+//! from a density that is piecewise constant *in solid angle* over cells of texels, with each
+//! cell's probability the integral of luminance over it: Σ luminance·Ω over its texels, where a
+//! texel of row y spans Ω = (2π/W)·(cos θ(y) − cos θ(y+1)). That is the luminance·sinθ weighting
+//! of the brief, integrated exactly, and it makes pdf_ω constant over each cell: the GPU stores it
+//! beside each texel's radiance, so one fetch gives both and no sinθ is ever divided by.
+//!
+//! Cells are single texels up to [`MAX_CELLS`] texels a side; larger maps use blocks of texels
+//! (the last block in a row or column may be smaller). Rows of cells are chosen by a marginal
+//! CDF, cells within a row by a conditional CDF; both are inverted by a search bounded by a guide
+//! table, which keeps the warp monotonic (so stratified points stay stratified) at the cost of
+//! about two table fetches.
 
 use super::Environment;
 use crate::shading::common::luminance;
 use glam::Vec3;
+use std::f64::consts::PI;
 
-/// The cell grid is at most this many cells wide, which keeps the tables inside every device's
-/// storage-buffer range (lavapipe's is 128 MiB). Sampling stays exact for the grid it describes.
-pub const MAX_COLUMNS: u32 = 4096;
+/// At most this many cells a side, which bounds the tables at 4096 × 4097 texels.
+pub const MAX_CELLS: u32 = 4096;
 
 /// Sampling tables, laid out as `glsl/include/environment.glsl` reads them.
 #[derive(Clone, Debug)]
@@ -22,119 +27,84 @@ pub struct Distribution {
     /// The map's size in texels.
     pub width: u32,
     pub height: u32,
-    /// Texels per cell side.
-    pub block: u32,
+    /// Texels per cell, across and down.
+    pub block_x: u32,
+    pub block_y: u32,
     pub columns: u32,
     pub rows: u32,
-    /// rows + 1 entries, from 0 to 1.
-    pub marginal_cdf: Vec<f32>,
-    /// rows + 1 entries: `guide[k]` is the last row r with `cdf[r] ≤ k/rows`.
-    pub marginal_guide: Vec<u32>,
-    /// rows × (columns + 1) entries, each row from 0 to 1.
-    pub conditional_cdf: Vec<f32>,
-    /// rows × (columns + 1) entries, a guide per row as for the marginal.
-    pub conditional_guide: Vec<u32>,
-    /// pdf over (u, v) of each cell, row-major; it integrates to 1 over [0, 1]².
+    /// The marginal table over rows of cells (`rows` entries), then one conditional table over
+    /// the cells of each row (`columns` entries each).
+    pub marginal: Table,
+    pub conditional: Vec<Table>,
+    /// pdf over solid angle of each cell, row-major.
     pub cell_pdf: Vec<f32>,
 }
 
-impl Distribution {
-    pub fn build(env: &Environment) -> Distribution {
-        Distribution::with_max_columns(env, MAX_COLUMNS)
-    }
+/// The inverse-CDF table of one discrete distribution over n intervals.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table {
+    /// n + 1 entries, exactly 0 first and 1 last.
+    pub cdf: Vec<f32>,
+    /// n + 1 entries: `guide[k]` is the last interval r < n with `cdf[r] ≤ u` for the smallest
+    /// f32 u that [`bucket`] puts in bucket k, so the answer for any u in bucket k lies in
+    /// `guide[k] ..= guide[k + 1]`.
+    pub guide: Vec<u32>,
+}
 
-    /// The tables with cells of square blocks of texels, so that there are at most
-    /// `max_columns` cells across.
-    pub fn with_max_columns(env: &Environment, max_columns: u32) -> Distribution {
-        let block = env.width.div_ceil(max_columns).max(1);
-        let columns = env.width.div_ceil(block);
-        let rows = env.height.div_ceil(block);
-        // Σ luminance·sinθ over each cell's texels: proportional to the cell's share of the
-        // integral of luminance over solid angle.
-        let mut weights = vec![0.0f64; (columns * rows) as usize];
-        for y in 0..env.height {
-            let sin_theta = (std::f64::consts::PI * (y as f64 + 0.5) / env.height as f64).sin();
-            for x in 0..env.width {
-                let cell = ((y / block) * columns + x / block) as usize;
-                weights[cell] += luminance(Vec3::from(env.texel(x, y))).max(0.0) as f64 * sin_theta;
-            }
-        }
-        Distribution::from_weights(env.width, env.height, block, &weights)
-    }
+/// The bucket of u among n, computed as the GPU does: ⌊u·n⌋ in f32 arithmetic.
+pub fn bucket(u: f32, n: u32) -> u32 {
+    ((u * n as f32) as u32).min(n - 1)
+}
 
-    /// The texel range [start, end) of cell `index` along an axis of `size` texels.
-    pub fn cell_span(&self, index: u32, size: u32) -> (u32, u32) {
-        let start = index * self.block;
-        (start, (start + self.block).min(size))
-    }
-
-    /// Tables for non-negative cell weights (row-major) over a `width`×`height` map with cells of
-    /// `block` texels. All-zero weights (a black map) fall back to uniform, so sampling stays
-    /// defined.
-    pub fn from_weights(width: u32, height: u32, block: u32, weights: &[f64]) -> Distribution {
-        let columns = width.div_ceil(block);
-        let rows = height.div_ceil(block);
-        let mut d = Distribution {
-            width,
-            height,
-            block,
-            columns,
-            rows,
-            marginal_cdf: Vec::new(),
-            marginal_guide: Vec::new(),
-            conditional_cdf: Vec::new(),
-            conditional_guide: Vec::new(),
-            cell_pdf: Vec::new(),
-        };
-        let total: f64 = weights.iter().sum();
-        let uniform: Vec<f64>;
-        let weights = if total > 0.0 {
-            weights
-        } else {
-            // Uniform over solid angle would need sinθ; uniform over texels is enough to keep
-            // a black map's sampling defined (it contributes nothing).
-            uniform = (0..rows).flat_map(|r| (0..columns).map(move |c| d_area(width, height, block, r, c))).collect();
-            &uniform[..]
-        };
-        let total: f64 = weights.iter().sum();
-        let mut row_sums = Vec::with_capacity(rows as usize);
-        for row in weights.chunks(columns as usize) {
-            row_sums.push(row.iter().sum::<f64>());
-            let cdf = cdf(row);
-            d.conditional_guide.extend(guide(&cdf));
-            d.conditional_cdf.extend(cdf);
-        }
-        d.marginal_cdf = cdf(&row_sums);
-        d.marginal_guide = guide(&d.marginal_cdf);
-        d.cell_pdf = (0..rows)
-            .flat_map(|r| (0..columns).map(move |c| (r, c)))
-            .map(|(r, c)| (weights[(r * columns + c) as usize] / total / d_area(width, height, block, r, c)) as f32)
+impl Table {
+    fn new(weights: &[f64]) -> Table {
+        let cdf = cdf(weights);
+        let n = weights.len() as u32;
+        let guide = (0..=n)
+            .map(|k| {
+                let u = if k == n { 1.0 } else { smallest_in_bucket(k, n) };
+                // Last r < n with cdf[r] <= u (cdf[0] = 0 always qualifies).
+                (cdf[..n as usize].partition_point(|&c| c <= u) - 1) as u32
+            })
             .collect();
-        d
+        Table { cdf, guide }
     }
 
-    /// The per-table header the GPU reads before the marginal CDF.
-    pub fn header(&self) -> [u32; 8] {
-        [self.width, self.height, self.block, self.columns, self.rows, 0, 0, 0]
+    pub fn len(&self) -> usize {
+        self.cdf.len() - 1
     }
 
-    /// The cell pdf of every texel, row-major: what the GPU stores in the radiance texels' alpha.
-    pub fn texel_pdf(&self) -> Vec<f32> {
-        let mut out = Vec::with_capacity((self.width * self.height) as usize);
-        for y in 0..self.height {
-            for x in 0..self.width {
-                out.push(self.cell_pdf[((y / self.block) * self.columns + x / self.block) as usize]);
+    /// The last interval r with `cdf[r] ≤ u`, as `env_search` finds it.
+    pub fn search(&self, u: f32) -> usize {
+        let k = bucket(u, self.len() as u32) as usize;
+        let (mut lo, mut hi) = (self.guide[k] as usize, self.guide[k + 1] as usize + 1);
+        while hi - lo > 1 {
+            let mid = (lo + hi) / 2;
+            if self.cdf[mid] <= u {
+                lo = mid;
+            } else {
+                hi = mid;
             }
         }
-        out
+        lo
+    }
+
+    /// The GPU texels of this table: entry i is (cdf[i], cdf[i+1], guide[i], guide[i+1]).
+    pub fn texels(&self) -> impl Iterator<Item = [f32; 4]> + '_ {
+        (0..self.len()).map(|i| [self.cdf[i], self.cdf[i + 1], self.guide[i] as f32, self.guide[i + 1] as f32])
     }
 }
 
-/// The area in (u, v) of cell (row, column).
-fn d_area(width: u32, height: u32, block: u32, row: u32, column: u32) -> f64 {
-    let w = ((column + 1) * block).min(width) - column * block;
-    let h = ((row + 1) * block).min(height) - row * block;
-    (w as f64 / width as f64) * (h as f64 / height as f64)
+/// The smallest f32 u in [0, 1) with `bucket(u, n) == k`.
+fn smallest_in_bucket(k: u32, n: u32) -> f32 {
+    let mut u = k as f32 / n as f32;
+    while u > 0.0 && bucket(u.next_down(), n) >= k {
+        u = u.next_down();
+    }
+    while bucket(u, n) < k {
+        u = u.next_up();
+    }
+    u
 }
 
 /// CDF of `weights` with one more entry than weights; exactly 0 first and 1 last. A row of zeros
@@ -154,18 +124,148 @@ fn cdf(weights: &[f64]) -> Vec<f32> {
     out
 }
 
-/// `guide[k]` (k = 0..=n) is the last interval r < n with `cdf[r] ≤ k/n`: a search for u only
-/// needs the intervals between the guides of the buckets around u, usually one or two.
-fn guide(cdf: &[f32]) -> Vec<u32> {
-    let n = cdf.len() - 1;
-    let mut out = Vec::with_capacity(n + 1);
-    let mut r = 0usize;
-    for k in 0..=n {
-        let threshold = k as f64 / n as f64;
-        while r + 1 < n && cdf[r + 1] as f64 <= threshold {
-            r += 1;
-        }
-        out.push(r as u32);
+/// cos θ at the top edge of texel row `y` of a map `height` texels high.
+pub fn row_cos(y: u32, height: u32) -> f64 {
+    (PI * y as f64 / height as f64).cos()
+}
+
+impl Distribution {
+    pub fn build(env: &Environment) -> Distribution {
+        Distribution::with_max_cells(env, MAX_CELLS)
     }
-    out
+
+    /// The tables with at most `max_cells` cells a side.
+    pub fn with_max_cells(env: &Environment, max_cells: u32) -> Distribution {
+        let (block_x, block_y) = (env.width.div_ceil(max_cells), env.height.div_ceil(max_cells));
+        let (columns, rows) = (env.width.div_ceil(block_x), env.height.div_ceil(block_y));
+        let mut weights = vec![0.0f64; (columns * rows) as usize];
+        for y in 0..env.height {
+            let omega = 2.0 * PI / env.width as f64 * (row_cos(y, env.height) - row_cos(y + 1, env.height));
+            for x in 0..env.width {
+                let cell = ((y / block_y) * columns + x / block_x) as usize;
+                weights[cell] += luminance(Vec3::from(env.texel(x, y))).max(0.0) as f64 * omega;
+            }
+        }
+        Distribution::from_weights(env.width, env.height, block_x, block_y, &weights)
+    }
+
+    /// The texel span [start, end) of cell `index` along an axis of `size` texels, `block` a cell.
+    pub fn span(index: u32, block: u32, size: u32) -> (u32, u32) {
+        (index * block, ((index + 1) * block).min(size))
+    }
+
+    /// The solid angle of cell (row, column).
+    pub fn cell_solid_angle(&self, row: u32, column: u32) -> f64 {
+        let (x0, x1) = Distribution::span(column, self.block_x, self.width);
+        let (y0, y1) = Distribution::span(row, self.block_y, self.height);
+        2.0 * PI * (x1 - x0) as f64 / self.width as f64 * (row_cos(y0, self.height) - row_cos(y1, self.height))
+    }
+
+    /// Tables for non-negative cell weights (row-major). All-zero weights (a black map) fall
+    /// back to uniform over solid angle, so sampling stays defined.
+    pub fn from_weights(width: u32, height: u32, block_x: u32, block_y: u32, weights: &[f64]) -> Distribution {
+        let (columns, rows) = (width.div_ceil(block_x), height.div_ceil(block_y));
+        let mut d = Distribution {
+            width,
+            height,
+            block_x,
+            block_y,
+            columns,
+            rows,
+            marginal: Table { cdf: Vec::new(), guide: Vec::new() },
+            conditional: Vec::new(),
+            cell_pdf: Vec::new(),
+        };
+        let solid_angles: Vec<f64> =
+            (0..rows).flat_map(|r| (0..columns).map(move |c| (r, c))).map(|(r, c)| d.cell_solid_angle(r, c)).collect();
+        let weights = if weights.iter().sum::<f64>() > 0.0 { weights } else { &solid_angles[..] };
+        let total: f64 = weights.iter().sum();
+        let row_sums: Vec<f64> = weights.chunks(columns as usize).map(|row| row.iter().sum()).collect();
+        d.conditional = weights.chunks(columns as usize).map(Table::new).collect();
+        d.marginal = Table::new(&row_sums);
+        d.cell_pdf = weights.iter().zip(&solid_angles).map(|(w, omega)| (w / total / omega) as f32).collect();
+        d
+    }
+
+    /// The header the GPU reads: sizes in texels, block sizes and the cell grid.
+    pub fn header(&self) -> [u32; 8] {
+        [self.width, self.height, self.block_x, self.block_y, self.columns, self.rows, 0, 0]
+    }
+
+    /// The cell pdf_ω of every texel, row-major: what the GPU stores beside the radiance.
+    pub fn texel_pdf(&self) -> Vec<f32> {
+        let mut out = Vec::with_capacity((self.width * self.height) as usize);
+        for y in 0..self.height {
+            for x in 0..self.width {
+                out.push(self.cell_pdf[((y / self.block_y) * self.columns + x / self.block_x) as usize]);
+            }
+        }
+        out
+    }
+
+    /// The tables as one RGBA32F image, `max(rows, columns)` texels wide and `rows + 1` high:
+    /// row 0 the marginal table, row 1 + r the conditional table of row r.
+    pub fn table_texels(&self) -> (u32, u32, Vec<[f32; 4]>) {
+        let width = self.rows.max(self.columns);
+        let mut texels = vec![[0.0f32; 4]; (width * (self.rows + 1)) as usize];
+        for (row, table) in std::iter::once(&self.marginal).chain(&self.conditional).enumerate() {
+            for (i, texel) in table.texels().enumerate() {
+                texels[row * width as usize + i] = texel;
+            }
+        }
+        (width, self.rows + 1, texels)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plain_search(cdf: &[f32], u: f32) -> usize {
+        cdf[..cdf.len() - 1].partition_point(|&c| c <= u) - 1
+    }
+
+    #[test]
+    fn guided_search_agrees_with_a_plain_search() {
+        // Plateaus (zero weights), tiny weights crowded into one bucket, and a dominant interval.
+        let mut weights = vec![0.0; 50];
+        weights.extend((0..300).map(|i| 1e-6 * (i % 7) as f64));
+        weights.push(1000.0);
+        weights.extend((0..40).map(|i| (i % 3) as f64));
+        let table = Table::new(&weights);
+        let n = table.len() as u32;
+        let mut probes: Vec<f32> = (0..20000).map(|i| i as f32 / 20000.0).collect();
+        for k in 0..n {
+            let u = smallest_in_bucket(k, n);
+            probes.extend([u, u.next_down().max(0.0), u.next_up()]);
+        }
+        probes.extend(table.cdf.iter().flat_map(|&c| [c, c.next_down().max(0.0), c.next_up()]).filter(|&u| u < 1.0));
+        for u in probes {
+            assert_eq!(table.search(u), plain_search(&table.cdf, u), "u = {u:e}");
+        }
+    }
+
+    #[test]
+    fn cells_cover_the_sphere_and_probabilities_sum_to_one() {
+        let env = Environment {
+            width: 301,
+            height: 150,
+            texels: (0..301 * 150).map(|i| [(i % 17) as f32, 1.0, 0.5]).collect(),
+            source: "test".into(),
+        };
+        for max_cells in [4096, 64] {
+            let d = Distribution::with_max_cells(&env, max_cells);
+            let mut sphere = 0.0;
+            let mut probability = 0.0;
+            for r in 0..d.rows {
+                for c in 0..d.columns {
+                    let omega = d.cell_solid_angle(r, c);
+                    sphere += omega;
+                    probability += d.cell_pdf[(r * d.columns + c) as usize] as f64 * omega;
+                }
+            }
+            assert!((sphere - 4.0 * PI).abs() < 1e-9, "{sphere}");
+            assert!((probability - 1.0).abs() < 1e-5, "{probability}");
+        }
+    }
 }

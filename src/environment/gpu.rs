@@ -5,12 +5,12 @@ use crate::gpu::{Binding, BindingKind, Buffer, Context, Image};
 use crate::{Error, Result};
 use ash::vk;
 
-/// The texels (radiance and cell pdf) and the sampling tables, uploaded once per environment.
+/// The texels (radiance and cell pdf), the sampling tables and their sizes, uploaded once per
+/// environment.
 pub struct GpuEnvironment {
     pub texels: Image,
-    pub marginal: Buffer,
-    pub conditional: Buffer,
-    pub guides: Buffer,
+    pub tables: Image,
+    pub info: Buffer,
 }
 
 impl GpuEnvironment {
@@ -26,29 +26,18 @@ impl GpuEnvironment {
         let rgba: Vec<[f32; 4]> =
             env.texels.iter().zip(distribution.texel_pdf()).map(|(t, pdf)| [t[0], t[1], t[2], pdf]).collect();
         texels.upload(ctx, bytemuck::cast_slice(&rgba))?;
-        let mut marginal = bytemuck::cast_slice::<u32, u8>(&distribution.header()).to_vec();
-        marginal.extend_from_slice(bytemuck::cast_slice(&distribution.marginal_cdf));
-        let guides: Vec<u32> =
-            distribution.marginal_guide.iter().chain(&distribution.conditional_guide).copied().collect();
-        Ok(GpuEnvironment {
-            texels,
-            marginal: Buffer::with_data(ctx, &marginal)?,
-            conditional: Buffer::with_data(ctx, bytemuck::cast_slice(&distribution.conditional_cdf))?,
-            guides: Buffer::with_data(ctx, bytemuck::cast_slice(&guides))?,
-        })
+        let (width, height, table_texels) = distribution.table_texels();
+        let tables = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 1, false)?;
+        tables.upload(ctx, bytemuck::cast_slice(&table_texels))?;
+        let info = Buffer::with_data(ctx, bytemuck::cast_slice(&distribution.header()))?;
+        Ok(GpuEnvironment { texels, tables, info })
     }
 
-    /// The four bindings of descriptor set 1, in `environment.glsl` order.
-    pub fn bindings(&self) -> [Binding<'_>; 4] {
-        [
-            Binding::Image(&self.texels),
-            Binding::Buffer(&self.marginal),
-            Binding::Buffer(&self.conditional),
-            Binding::Buffer(&self.guides),
-        ]
+    /// The bindings of descriptor set 1, in `environment.glsl` order.
+    pub fn bindings(&self) -> [Binding<'_>; 3] {
+        [Binding::Image(&self.texels), Binding::Image(&self.tables), Binding::Buffer(&self.info)]
     }
 }
 
 /// The layout of descriptor set 1.
-pub const SET_LAYOUT: [BindingKind; 4] =
-    [BindingKind::StorageImage, BindingKind::StorageBuffer, BindingKind::StorageBuffer, BindingKind::StorageBuffer];
+pub const SET_LAYOUT: [BindingKind; 3] = [BindingKind::StorageImage, BindingKind::StorageImage, BindingKind::StorageBuffer];

@@ -1,6 +1,7 @@
 //! Mirror of `glsl/include/environment.glsl`: the lat-long mapping, texel and background
-//! lookups, and sampling the piecewise-constant distribution.
+//! lookups, and sampling the distribution.
 
+use super::distribution::row_cos;
 use super::{Distribution, Environment};
 use crate::shading::common::{INV_PI, INV_TWO_PI, ONE_MINUS_EPSILON, PI, TWO_PI};
 use glam::{UVec2, Vec2, Vec3};
@@ -13,11 +14,15 @@ pub fn direction_to_uv(d: Vec3) -> Vec2 {
     Vec2::new(u, v)
 }
 
+/// The direction with azimuth `u` and polar angle θ given by its cosine and sine.
+pub fn direction(u: f32, cos_theta: f32, sin_theta: f32) -> Vec3 {
+    let phi = TWO_PI * (u - 0.5);
+    Vec3::new(sin_theta * phi.sin(), cos_theta, -sin_theta * phi.cos())
+}
+
 pub fn uv_to_direction(uv: Vec2) -> Vec3 {
-    let phi = TWO_PI * (uv.x - 0.5);
     let theta = PI * uv.y;
-    let sin_theta = theta.sin();
-    Vec3::new(sin_theta * phi.sin(), theta.cos(), -sin_theta * phi.cos())
+    direction(uv.x, theta.cos(), theta.sin())
 }
 
 /// The texel holding `uv`.
@@ -30,16 +35,6 @@ pub fn texel_of(width: u32, height: u32, uv: Vec2) -> UVec2 {
 pub fn radiance(env: &Environment, uv: Vec2) -> Vec3 {
     let t = texel_of(env.width, env.height, uv);
     Vec3::from(env.texel(t.x, t.y))
-}
-
-/// pdf over solid angle from pdf_uv, at a unit direction `d`.
-pub fn solid_angle_pdf(pdf_uv: f32, d: Vec3) -> f32 {
-    let sin_theta = (1.0 - d.y * d.y).max(0.0).sqrt();
-    if sin_theta > 0.0 {
-        pdf_uv / (2.0 * PI * PI * sin_theta)
-    } else {
-        0.0
-    }
 }
 
 /// Bilinear radiance between texel centres, wrapping in u and clamping in v: for the background.
@@ -61,57 +56,39 @@ pub fn background(env: &Environment, uv: Vec2) -> Vec3 {
 }
 
 impl Distribution {
-    /// pdf_uv of the cell holding `uv`.
-    pub fn uv_pdf(&self, uv: Vec2) -> f32 {
-        let t = texel_of(self.width, self.height, uv) / self.block;
-        self.cell_pdf[(t.y * self.columns + t.x) as usize]
+    /// pdf over solid angle of the cell holding texel `t`.
+    pub fn texel_cell_pdf(&self, t: UVec2) -> f32 {
+        self.cell_pdf[((t.y / self.block_y) * self.columns + t.x / self.block_x) as usize]
     }
 
-    /// pdf over solid angle of [`Distribution::sample`] producing direction `d` at `uv`.
-    pub fn pdf(&self, uv: Vec2, d: Vec3) -> f32 {
-        solid_angle_pdf(self.uv_pdf(uv), d)
+    /// pdf over solid angle of [`Distribution::sample`] producing a direction at `uv`.
+    pub fn pdf(&self, uv: Vec2) -> f32 {
+        self.texel_cell_pdf(texel_of(self.width, self.height, uv))
     }
 
-    /// Last interval r with `cdf[r] ≤ u`, searched between the guides around u's bucket.
-    fn search(cdf: &[f32], guide: &[u32], u: f32) -> usize {
-        let n = cdf.len() - 1;
-        let k = (u * n as f32) as i64;
-        let mut lo = guide[(k - 1).max(0) as usize] as usize;
-        let mut hi = (guide[(k + 2).min(n as i64) as usize] as usize + 1).min(n);
-        while hi - lo > 1 {
-            let mid = (lo + hi) / 2;
-            if cdf[mid] <= u {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        lo
-    }
-
-    /// Samples a direction; returns it with its uv and the texel the sample lies in.
-    pub fn sample(&self, u: Vec2) -> (Vec3, Vec2, UVec2) {
-        let row = Distribution::search(&self.marginal_cdf, &self.marginal_guide, u.y);
-        let (r0, r1) = (self.marginal_cdf[row], self.marginal_cdf[row + 1]);
+    /// Samples a direction: a cell by the tables, then uniformly in solid angle within it.
+    /// Returns the direction and the texel it lies in.
+    pub fn sample(&self, u: Vec2) -> (Vec3, UVec2) {
+        let row = self.marginal.search(u.y);
+        let (r0, r1) = (self.marginal.cdf[row], self.marginal.cdf[row + 1]);
         let dv = if r1 > r0 { (u.y - r0) / (r1 - r0) } else { 0.5 };
-        let stride = self.columns as usize + 1;
-        let cdf = &self.conditional_cdf[row * stride..(row + 1) * stride];
-        let guide = &self.conditional_guide[row * stride..(row + 1) * stride];
-        let column = Distribution::search(cdf, guide, u.x);
-        let (c0, c1) = (cdf[column], cdf[column + 1]);
+        let table = &self.conditional[row];
+        let column = table.search(u.x);
+        let (c0, c1) = (table.cdf[column], table.cdf[column + 1]);
         let du = if c1 > c0 { (u.x - c0) / (c1 - c0) } else { 0.5 };
+        let (du, dv) = (du.min(ONE_MINUS_EPSILON), dv.min(ONE_MINUS_EPSILON));
 
-        let start = UVec2::new(column as u32, row as u32) * self.block;
-        let end = (start + self.block).min(UVec2::new(self.width, self.height));
-        let position = start.as_vec2() + Vec2::new(du, dv).min(Vec2::splat(ONE_MINUS_EPSILON)) * (end - start).as_vec2();
-        let uv = position / Vec2::new(self.width as f32, self.height as f32);
-        let texel = position.as_uvec2().min(end - 1);
-        (uv_to_direction(uv), uv, texel)
-    }
-
-    /// pdf over solid angle of a sample returned by [`Distribution::sample`].
-    pub fn sample_pdf(&self, d: Vec3, texel: UVec2) -> f32 {
-        let cell = texel / self.block;
-        solid_angle_pdf(self.cell_pdf[(cell.y * self.columns + cell.x) as usize], d)
+        let start = UVec2::new(column as u32 * self.block_x, row as u32 * self.block_y);
+        let end = (start + UVec2::new(self.block_x, self.block_y)).min(UVec2::new(self.width, self.height));
+        let x = start.x as f32 + du * (end.x - start.x) as f32;
+        let (z0, z1) = (row_cos(start.y, self.height) as f32, row_cos(end.y, self.height) as f32);
+        let z = z0 + (z1 - z0) * dv;
+        let sin_theta = (1.0 - z * z).max(0.0).sqrt();
+        let y = if self.block_y == 1 {
+            start.y
+        } else {
+            ((sin_theta.atan2(z) * INV_PI * self.height as f32) as u32).clamp(start.y, end.y - 1)
+        };
+        (direction(x / self.width as f32, z, sin_theta), UVec2::new((x as u32).min(end.x - 1), y))
     }
 }
