@@ -19,7 +19,9 @@ fn main() {
         r.set_seed(batch);
         let t = Instant::now();
         let mut gpu = 0.0;
-        for _ in 0..(64 / batch) { gpu += r.render_samples(batch).unwrap().unwrap_or(0.0); }
+        for _ in 0..(64 / batch) {
+            gpu += r.render_samples(batch).unwrap().unwrap_or(0.0);
+        }
         println!("batch {batch:3}: wall {:.3} s, gpu {:.3} s for 64 spp", t.elapsed().as_secs_f64(), gpu);
     }
 }

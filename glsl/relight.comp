@@ -5,7 +5,7 @@
 // bits.
 #extension GL_GOOGLE_include_directive : require
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = 16, local_size_y = 16) in;
 
 #include "common.glsl"
 #include "material.glsl"

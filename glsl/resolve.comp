@@ -4,7 +4,7 @@
 // is its mask (or 1 − mask when inverted; 1 without a mask). Runs once per edit, not per sample.
 #extension GL_GOOGLE_include_directive : require
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = 16, local_size_y = 16) in;
 
 // Per pixel: the index of its object's stack.
 layout(set = 0, binding = 0, r32ui) uniform readonly uimage2D stack_index;

@@ -275,7 +275,8 @@ fn check_environment_cells(env: &Environment, distribution: &Distribution, sampl
     let mut expected = vec![0.0; nx * ny];
     for row in 0..rows {
         for column in 0..cols {
-            let p = distribution.cell_pdf[(row * cols + column) as usize] as f64 * distribution.cell_solid_angle(row, column);
+            let p = distribution.cell_pdf[(row * cols + column) as usize] as f64
+                * distribution.cell_solid_angle(row, column);
             expected[(row / by) as usize * nx + (column / bx) as usize] += p * samples.len() as f64;
         }
     }

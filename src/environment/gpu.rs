@@ -40,4 +40,5 @@ impl GpuEnvironment {
 }
 
 /// The layout of descriptor set 1.
-pub const SET_LAYOUT: [BindingKind; 3] = [BindingKind::StorageImage, BindingKind::StorageImage, BindingKind::StorageBuffer];
+pub const SET_LAYOUT: [BindingKind; 3] =
+    [BindingKind::StorageImage, BindingKind::StorageImage, BindingKind::StorageBuffer];

@@ -10,8 +10,9 @@ use crate::render::tonemap::Tonemap;
 use crate::Result;
 use ash::vk;
 
-/// Workgroup edge of the 2D kernels (`local_size_x/y` in glsl/*.comp).
-const LOCAL_SIZE: u32 = 8;
+/// Workgroup size of the 2D kernels (`local_size_x`, `local_size_y` in glsl/*.comp).
+const LOCAL_SIZE_X: u32 = 16;
+const LOCAL_SIZE_Y: u32 = 16;
 
 /// How the environment lights the scene. Any change restarts accumulation.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -214,7 +215,7 @@ impl Renderer {
                 Binding::Image(&self.resolved),
             ],
         )?;
-        let groups = [group_count(width, LOCAL_SIZE), group_count(height, LOCAL_SIZE), 1];
+        let groups = [group_count(width, LOCAL_SIZE_X), group_count(height, LOCAL_SIZE_Y), 1];
         let time = self.timed(|renderer, cmd| renderer.resolve.dispatch(cmd, &[&set], &[], groups))?;
         self.stacks = Some(GpuStacks {
             _stack_index: stack_index,
@@ -260,7 +261,7 @@ impl Renderer {
             intensity: self.lighting.intensity,
             image_width: self.width,
         };
-        let groups = [group_count(self.width, LOCAL_SIZE), group_count(self.height, LOCAL_SIZE), 1];
+        let groups = [group_count(self.width, LOCAL_SIZE_X), group_count(self.height, LOCAL_SIZE_Y), 1];
         let time = self.timed(|renderer, cmd| {
             renderer.relight.dispatch(
                 cmd,
@@ -289,7 +290,7 @@ impl Renderer {
             tonemap: tonemap.gpu_id(),
             straight_alpha: !self.lighting.background as u32,
         };
-        let groups = [group_count(self.width, LOCAL_SIZE), group_count(self.height, LOCAL_SIZE), 1];
+        let groups = [group_count(self.width, LOCAL_SIZE_X), group_count(self.height, LOCAL_SIZE_Y), 1];
         let staging = Buffer::staging(&self.ctx, self.display_image.byte_size())?;
         self.ctx.run(|cmd| {
             self.display.dispatch(cmd, &[&self.display_set], bytemuck::bytes_of(&push), groups);

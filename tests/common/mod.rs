@@ -5,4 +5,6 @@ pub mod albedo;
 pub mod gpu;
 pub mod random;
 pub mod reference;
+pub mod reference_render;
+pub mod scenes;
 pub mod stats;

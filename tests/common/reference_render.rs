@@ -1,0 +1,91 @@
+//! A CPU mirror of `glsl/relight.comp`: the same per-pixel set-up, Sobol points, environment
+//! sample, BRDF sample and MIS weights, written with the Rust mirrors of the GLSL includes. It
+//! is slow and exact to float rounding, for comparing the GPU kernel pixel by pixel.
+
+use glam::{Vec2, Vec3, Vec4};
+use lookdev::environment::sampling::{background, direction_to_uv, texel_of};
+use lookdev::environment::{Distribution, Environment};
+use lookdev::gbuffer::GBuffer;
+use lookdev::material::Params;
+use lookdev::render::Lighting;
+use lookdev::shading::brdf::{disney_brdf, make_half_vector, make_lobes, make_view};
+use lookdev::shading::frame::{environment_from_world, Frame};
+use lookdev::shading::sampling::{brdf_pdf, choose_lobes, mis_weight_over_pdf, sample_brdf};
+use lookdev::shading::sobol::{hash_combine, hash_u32, sobol_owen_2d};
+
+pub struct Reference<'a> {
+    pub gbuffer: &'a GBuffer,
+    pub env: &'a Environment,
+    pub distribution: Distribution,
+    pub lighting: Lighting,
+    pub seed: u32,
+}
+
+impl Reference<'_> {
+    /// The running sum (rgb radiance, a coverage) of pixel (x, y) after `spp` samples, as the
+    /// accumulation image holds it, for a pixel whose resolved material is `params`.
+    pub fn pixel(&self, x: u32, y: u32, params: &Params, spp: u32) -> Vec4 {
+        let g = self.gbuffer;
+        let i = (y * g.width + x) as usize;
+        let coverage = g.coverage[i];
+        let view = Vec3::from(g.view[i]);
+        let rotation = self.lighting.rotation_degrees.to_radians();
+        let (cos_r, sin_r) = (rotation.cos(), rotation.sin());
+        let to_env = |d: Vec3| environment_from_world(d, cos_r, sin_r);
+        let bg = if self.lighting.background && coverage < 1.0 {
+            self.lighting.intensity * background(self.env, direction_to_uv(to_env(-view)))
+        } else {
+            Vec3::ZERO
+        };
+        let mut sum = Vec4::ZERO;
+        if coverage <= 0.0 {
+            for _ in 0..spp {
+                sum += bg.extend(0.0);
+            }
+            return sum;
+        }
+        let n = Vec3::from(g.normal[i]);
+        let frame = Frame::new(n, Vec3::from(g.tangent[i]));
+        let v = frame.to_local(view);
+        let lobes = make_lobes(params);
+        let view_terms = make_view(&lobes, v);
+        let choice = choose_lobes(&lobes, &view_terms);
+        let env_frame = frame.rotated_into_environment(cos_r, sin_r);
+        let pixel_seed = hash_combine(hash_u32(self.seed), y * g.width + x);
+        let env_seed = hash_combine(pixel_seed, 0x454e56);
+        let brdf_seed = hash_combine(pixel_seed, 0x425244);
+        let texel = |d: Vec3| {
+            let t = texel_of(self.env.width, self.env.height, direction_to_uv(d));
+            (Vec3::from(self.env.texel(t.x, t.y)), self.distribution.texel_cell_pdf(t))
+        };
+        for s in 0..spp {
+            let mut radiance = Vec3::ZERO;
+            if v.z > 0.0 {
+                let (u_env, u_brdf): (Vec2, Vec2) = (sobol_owen_2d(s, env_seed), sobol_owen_2d(s, brdf_seed));
+                let (d, t) = self.distribution.sample(u_env);
+                let (le, pdf_env) = (Vec3::from(self.env.texel(t.x, t.y)), self.distribution.texel_cell_pdf(t));
+                let l = env_frame.to_local(d);
+                if l.z > 0.0 && pdf_env > 0.0 {
+                    let hv = make_half_vector(&lobes, l, v);
+                    let f = disney_brdf(&lobes, &view_terms, l, &hv);
+                    let pdf_brdf = brdf_pdf(&choice, &view_terms, l, &hv);
+                    radiance += f * (l.z * mis_weight_over_pdf(pdf_env, pdf_brdf)) * le;
+                }
+                let l = sample_brdf(&lobes, &choice, &view_terms, u_brdf);
+                if l.z > 0.0 {
+                    let hv = make_half_vector(&lobes, l, v);
+                    let pdf_brdf = brdf_pdf(&choice, &view_terms, l, &hv);
+                    if pdf_brdf > 0.0 {
+                        let d = env_frame.to_world(l).normalize();
+                        let (le, pdf_env) = texel(d);
+                        let f = disney_brdf(&lobes, &view_terms, l, &hv);
+                        radiance += f * (l.z * mis_weight_over_pdf(pdf_brdf, pdf_env)) * le;
+                    }
+                }
+                radiance *= self.lighting.intensity;
+            }
+            sum += (coverage * radiance + (1.0 - coverage) * bg).extend(coverage);
+        }
+        sum
+    }
+}
