@@ -105,9 +105,7 @@ fn furnace_matches_integrated_albedo() {
 fn shaderball_scene(size: u32) -> (GBuffer, Look, PackedStacks) {
     let gbuffer = GBuffer::shaderball(size, size);
     let look = Look::builtin_default();
-    let mut ids = gbuffer.object_id.clone();
-    ids.sort_unstable();
-    ids.dedup();
+    let ids = lookdev::render::scene::covered_object_ids(&gbuffer);
     let masks: Vec<String> = gbuffer.masks.keys().cloned().collect();
     let stacks = PackedStacks::pack(&look, ids, &masks, Path::new("shader ball")).unwrap();
     (gbuffer, look, stacks)
@@ -130,7 +128,7 @@ fn gpu_resolve_matches_the_cpu_blend() {
     let resolved = r.read_resolved().unwrap();
     let pixels = gbuffer.pixel_count();
     let mut blended = 0;
-    for i in 0..pixels {
+    for i in (0..pixels).filter(|&i| gbuffer.coverage[i] > 0.0) {
         let cpu = stacks.resolve_pixel(gbuffer.object_id[i], |m| gbuffer.masks[&stacks.masks[m]][i]);
         let gpu = resolved_params(&resolved, pixels, i);
         let (a, b) = (cpu.to_gpu(), gpu.to_gpu());
@@ -174,7 +172,11 @@ fn gpu_relight_matches_the_cpu_mirror() {
     for y in 0..gbuffer.height {
         for x in 0..gbuffer.width {
             let i = (y * gbuffer.width + x) as usize;
-            let params = stacks.resolve_pixel(gbuffer.object_id[i], |m| gbuffer.masks[&stacks.masks[m]][i]);
+            let params = if gbuffer.coverage[i] > 0.0 {
+                stacks.resolve_pixel(gbuffer.object_id[i], |m| gbuffer.masks[&stacks.masks[m]][i])
+            } else {
+                Params::default()
+            };
             let cpu = reference.pixel(x, y, &params, spp) / spp as f32;
             let gpu = glam::Vec4::from(radiance[i]);
             covered += (gbuffer.coverage[i] > 0.0) as usize;

@@ -150,6 +150,22 @@ impl Look {
     /// The look used for a user g-buffer rendered without a look: every object in the default
     /// material (LOOKDEV.md §3 defaults: grey 0.8 dielectric, roughness 0.5), default settings.
     pub fn default_material() -> Look {
+        let mut look = Look {
+            file: None,
+            environment: EnvironmentSettings::default(),
+            render: RenderSettings::default(),
+            objects: Vec::new(),
+        };
+        look.ensure_default_stack();
+        look
+    }
+
+    /// Gives a look without a default stack one of a single default-material layer, so every
+    /// object has a stack that `--set` can reach. Returns whether it added one.
+    pub fn ensure_default_stack(&mut self) -> bool {
+        if self.objects.iter().any(|o| o.id.is_none()) {
+            return false;
+        }
         let layer = Layer {
             preset: None,
             params: Params::default(),
@@ -159,12 +175,8 @@ impl Look {
             opacity: 1.0,
             line: 0,
         };
-        Look {
-            file: None,
-            environment: EnvironmentSettings::default(),
-            render: RenderSettings::default(),
-            objects: vec![ObjectStack { id: None, layers: vec![layer] }],
-        }
+        self.objects.push(ObjectStack { id: None, layers: vec![layer] });
+        true
     }
 
     /// The stack for an object id: its own, else the default stack, else `None`.

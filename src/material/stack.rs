@@ -41,9 +41,10 @@ pub struct PackedStacks {
 }
 
 impl PackedStacks {
-    /// Packs the look's stacks for the objects in `object_ids`. An object with neither its own
-    /// stack nor a default stack gets the default parameters (and a warning). A mask the look
-    /// names that `available_masks` lacks is an error naming both files and the layer's line.
+    /// Packs the look's stacks for the objects in `object_ids` (those that are shaded). An object
+    /// with neither its own stack nor a default stack gets the default parameters (and a
+    /// warning). A mask the look names that `available_masks` lacks is an error naming both files
+    /// and the layer's line. Stack 0 always exists, for the pixels that shade nothing.
     pub fn pack(
         look: &Look,
         object_ids: impl IntoIterator<Item = u32>,
@@ -116,6 +117,18 @@ impl PackedStacks {
             let layer_count = packed.layers.len() as u32 - first_layer;
             packed.stack_of_object.insert(id, packed.stacks.len() as u32);
             packed.stacks.push(GpuStack { first_layer, layer_count, pad: [0; 2] });
+        }
+        // Pixels that shade nothing still index a stack; with no shaded object at all, that is
+        // a default-material stack.
+        if packed.stacks.is_empty() {
+            packed.layers.push(GpuLayer {
+                params: Params::default().to_gpu(),
+                mask: -1,
+                invert: 0,
+                opacity: 1.0,
+                pad: 0,
+            });
+            packed.stacks.push(GpuStack { first_layer: 0, layer_count: 1, pad: [0; 2] });
         }
         if !unstyled.is_empty() {
             let ids: Vec<String> = unstyled.iter().map(u32::to_string).collect();

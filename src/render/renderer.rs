@@ -191,7 +191,9 @@ impl Renderer {
         let ctx = &self.ctx;
         let (width, height) = (self.width, self.height);
         let pixels = (width * height) as usize;
-        let index: Vec<u32> = self.object_ids.iter().map(|id| packed.stack_of_object[id]).collect();
+        // Uncovered pixels may carry ids the stacks leave out; they shade nothing, so stack 0 does.
+        let index: Vec<u32> =
+            self.object_ids.iter().map(|id| packed.stack_of_object.get(id).copied().unwrap_or(0)).collect();
         let stack_index = Image::new(ctx, vk::Format::R32_UINT, width, height, 1, false)?;
         stack_index.upload(ctx, bytemuck::cast_slice(&index))?;
         // At least one mask layer, so the binding is always valid.

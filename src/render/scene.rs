@@ -32,11 +32,8 @@ impl Scene {
         environment: Environment,
         settings: Settings,
     ) -> Result<Scene> {
-        let mut ids: Vec<u32> = gbuffer.object_id.clone();
-        ids.sort_unstable();
-        ids.dedup();
         let available: Vec<String> = gbuffer.masks.keys().cloned().collect();
-        let stacks = PackedStacks::pack(&look, ids, &available, &gbuffer_name)?;
+        let stacks = PackedStacks::pack(&look, covered_object_ids(&gbuffer), &available, &gbuffer_name)?;
         Ok(Scene { gbuffer, gbuffer_name, look, environment, settings, stacks })
     }
 
@@ -55,6 +52,8 @@ impl Scene {
             None if gbuffer.is_none() => Look::builtin_default(),
             None => Look::default_material(),
         };
+        let had_stacks = !look.objects.is_empty();
+        let implicit_default = look.ensure_default_stack();
         for (param, value) in sets {
             look.set_everywhere(*param, *value);
         }
@@ -67,6 +66,29 @@ impl Scene {
             Some(path) => environment::load::load(path, env_options)?,
             None => Environment::studio(),
         };
+        if implicit_default && had_stacks {
+            let unstyled: Vec<String> = covered_object_ids(&gbuffer)
+                .into_iter()
+                .filter(|id| !look.objects.iter().any(|o| o.id == Some(*id)))
+                .map(|id| id.to_string())
+                .collect();
+            if !unstyled.is_empty() {
+                let name = look.file.as_deref().map(|p| p.display().to_string()).unwrap_or_default();
+                crate::warn(format!(
+                    "{name}: object id {} has no stack and the look has no default stack; the default material is used",
+                    unstyled.join(", ")
+                ));
+            }
+        }
         Scene::new(gbuffer, gbuffer_name, look, environment, settings)
     }
+}
+
+/// The distinct object ids of the pixels that are shaded (coverage > 0), ascending.
+pub fn covered_object_ids(gbuffer: &GBuffer) -> Vec<u32> {
+    let mut ids: Vec<u32> =
+        gbuffer.object_id.iter().zip(&gbuffer.coverage).filter(|(_, &a)| a > 0.0).map(|(&id, _)| id).collect();
+    ids.sort_unstable();
+    ids.dedup();
+    ids
 }

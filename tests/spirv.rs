@@ -1,0 +1,100 @@
+//! The committed SPIR-V in `spirv/` is what `glsl/` compiles to, and it validates.
+//!
+//! Both checks need the Khronos tools (Debian: glslang-tools, spirv-tools) and are skipped, with
+//! a note, where they are missing; CI installs them. To regenerate the SPIR-V after editing a
+//! kernel: `LOOKDEV_BLESS_SPIRV=1 cargo test --release --test spirv`.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn kernels() -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(root().join("glsl"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "comp"))
+        .collect();
+    files.sort();
+    files
+}
+
+fn tool(name: &str) -> bool {
+    Command::new(name).arg("--version").output().is_ok()
+}
+
+fn spirv_path(kernel: &Path) -> PathBuf {
+    root().join("spirv").join(format!("{}.spv", kernel.file_name().unwrap().to_string_lossy()))
+}
+
+#[test]
+fn every_kernel_is_registered_and_committed() {
+    let names: Vec<String> = kernels().iter().map(|k| k.file_stem().unwrap().to_string_lossy().into_owned()).collect();
+    let registered: Vec<&str> = lookdev::gpu::shaders::ALL.iter().map(|k| k.name).collect();
+    for name in &names {
+        assert!(registered.contains(&name.as_str()), "glsl/{name}.comp is not in gpu::shaders::ALL");
+    }
+    for name in &registered {
+        assert!(names.iter().any(|n| n == name), "gpu::shaders::ALL lists {name}, but glsl/{name}.comp is missing");
+    }
+    for kernel in kernels() {
+        let bytes = std::fs::read(spirv_path(&kernel)).expect("compiled SPIR-V is committed");
+        let embedded = lookdev::gpu::shaders::ALL
+            .iter()
+            .find(|k| k.name == kernel.file_stem().unwrap().to_string_lossy())
+            .unwrap();
+        assert_eq!(bytes, embedded.spirv, "the binary embeds stale SPIR-V for {}", kernel.display());
+    }
+}
+
+#[test]
+fn committed_spirv_matches_the_glsl() {
+    if !tool("glslangValidator") {
+        eprintln!("note: glslangValidator is not installed (Debian: glslang-tools); SPIR-V freshness not checked");
+        return;
+    }
+    let bless = std::env::var("LOOKDEV_BLESS_SPIRV").is_ok_and(|v| v == "1");
+    let out_dir = std::env::temp_dir().join(format!("lookdev-spirv-{}", std::process::id()));
+    std::fs::create_dir_all(&out_dir).unwrap();
+    let mut stale = Vec::new();
+    for kernel in kernels() {
+        let out = out_dir.join(spirv_path(&kernel).file_name().unwrap());
+        // The exact command the committed files come from.
+        let status = Command::new("glslangValidator")
+            .current_dir(root())
+            .args(["--quiet", "--target-env", "vulkan1.3", "-Iglsl", "-Iglsl/include", "-o"])
+            .arg(&out)
+            .arg(kernel.strip_prefix(root()).unwrap())
+            .status()
+            .unwrap();
+        assert!(status.success(), "{} does not compile", kernel.display());
+        let fresh = std::fs::read(&out).unwrap();
+        if std::fs::read(spirv_path(&kernel)).ok().as_deref() != Some(&fresh[..]) {
+            if bless {
+                std::fs::write(spirv_path(&kernel), &fresh).unwrap();
+            } else {
+                stale.push(kernel.display().to_string());
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&out_dir);
+    assert!(
+        stale.is_empty(),
+        "stale SPIR-V for {stale:?}; run LOOKDEV_BLESS_SPIRV=1 cargo test --release --test spirv and commit spirv/"
+    );
+}
+
+#[test]
+fn committed_spirv_validates() {
+    if !tool("spirv-val") {
+        eprintln!("note: spirv-val is not installed (Debian: spirv-tools); SPIR-V not validated");
+        return;
+    }
+    for kernel in kernels() {
+        let output =
+            Command::new("spirv-val").args(["--target-env", "vulkan1.3"]).arg(spirv_path(&kernel)).output().unwrap();
+        assert!(output.status.success(), "{}: {}", kernel.display(), String::from_utf8_lossy(&output.stderr));
+    }
+}
