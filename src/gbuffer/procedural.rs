@@ -20,7 +20,7 @@ const STRIPE_SOFTNESS: f32 = 0.012;
 /// soft threshold applied to the fBm (in its \[-1,1\] range) that turns it into patches of grime.
 const GRUNGE_FREQUENCY: f32 = 2.5;
 const GRUNGE_OCTAVES: usize = 6;
-const GRUNGE_THRESHOLD: (f32, f32) = (0.05, 0.3);
+const GRUNGE_THRESHOLD: (f32, f32) = (0.12, 0.4);
 /// The root-mean-square gradient of [`value_noise`] per unit of its input (checked by a test).
 const NOISE_SLOPE: f32 = 1.3;
 
