@@ -1,8 +1,9 @@
 #version 460
 // One progressive pass of image-based relighting: for each covered pixel and each sample index,
 // one environment sample and one BRDF sample, combined with the power heuristic (LOOKDEV.md §5).
-// The running float32 sum is accumulated in sample order, so any split into passes gives the same
-// bits.
+// The running float32 sum of the estimates is accumulated in sample order, so any split into
+// passes gives the same bits. Coverage and the background are composited by finalize.comp, so
+// background pixels cost nothing after the first pass of an accumulation.
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 16, local_size_y = 16) in;
@@ -18,8 +19,10 @@ layout(local_size_x = 16, local_size_y = 16) in;
 layout(set = 0, binding = 0, rgba32f) uniform readonly image2DArray surface;
 // The resolved material, four layers as material.glsl unpacks them.
 layout(set = 0, binding = 1, rgba32f) uniform readonly image2DArray resolved;
-// Running sums: rgb radiance, a coverage.
+// Running sums of the radiance estimates of covered pixels (rgb); uncovered pixels are not written.
 layout(set = 0, binding = 2, rgba32f) uniform image2D accumulation;
+// The environment behind each pixel (rgb), written by the first pass of an accumulation.
+layout(set = 0, binding = 3, rgba32f) uniform writeonly image2D background;
 
 layout(push_constant) uniform Pass {
     uint first_sample;     // 0 starts a new accumulation
@@ -74,42 +77,41 @@ void main() {
         return;
     }
     vec4 normal_coverage = imageLoad(surface, ivec3(pixel, 0));
-    vec3 view = imageLoad(surface, ivec3(pixel, 1)).xyz;
     float coverage = normal_coverage.w;
-
-    vec3 background = vec3(0.0);
-    if (pass.show_background != 0u && coverage < 1.0) {
-        background = pass.intensity * env_background(env_direction_to_uv(to_environment(-view)));
+    vec3 view = imageLoad(surface, ivec3(pixel, 1)).xyz;
+    if (pass.first_sample == 0u) {
+        // The same for every pass, so computed once per accumulation.
+        vec3 behind = vec3(0.0);
+        if (pass.show_background != 0u && coverage < 1.0) {
+            behind = pass.intensity * env_background(env_direction_to_uv(to_environment(-view)));
+        }
+        imageStore(background, pixel, vec4(behind, 0.0));
     }
-    vec4 sum = pass.first_sample == 0u ? vec4(0.0) : imageLoad(accumulation, pixel);
-    uint last = pass.first_sample + pass.sample_count;
+    if (coverage <= 0.0) {
+        return;
+    }
 
-    if (coverage > 0.0) {
-        vec3 n = normal_coverage.xyz;
-        vec3 t = imageLoad(surface, ivec3(pixel, 2)).xyz;
-        vec3 b = cross(n, t);
-        vec3 v = vec3(dot(view, t), dot(view, b), dot(view, n));
+    vec3 n = normal_coverage.xyz;
+    vec3 t = imageLoad(surface, ivec3(pixel, 2)).xyz;
+    vec3 b = cross(n, t);
+    vec3 v = vec3(dot(view, t), dot(view, b), dot(view, n));
+    vec4 sum = pass.first_sample == 0u ? vec4(0.0) : imageLoad(accumulation, pixel);
+    // Facing away from the eye (a shading normal can), the BRDF is zero: nothing to add.
+    if (v.z > 0.0) {
         Material m = unpack_material(imageLoad(resolved, ivec3(pixel, 0)), imageLoad(resolved, ivec3(pixel, 1)),
                                      imageLoad(resolved, ivec3(pixel, 2)), imageLoad(resolved, ivec3(pixel, 3)));
         Lobes s = make_lobes(m);
-        View view = make_view(s, v);
-        LobeChoice choice = choose_lobes(s, view);
+        View view_terms = make_view(s, v);
+        LobeChoice choice = choose_lobes(s, view_terms);
         vec3 fx = to_environment(t);
         vec3 fy = to_environment(b);
         vec3 fn = to_environment(n);
         uint pixel_seed = hash_combine(hash_u32(pass.seed), uint(pixel.y) * pass.image_width + uint(pixel.x));
         uint env_seed = hash_combine(pixel_seed, 0x454e56u);
         uint brdf_seed = hash_combine(pixel_seed, 0x425244u);
+        uint last = pass.first_sample + pass.sample_count;
         for (uint i = pass.first_sample; i < last; i++) {
-            vec3 radiance = vec3(0.0);
-            if (v.z > 0.0) {
-                radiance = estimate(s, choice, view, fx, fy, fn, sobol_owen_2d(i, env_seed), sobol_owen_2d(i, brdf_seed));
-            }
-            sum += vec4(coverage * radiance + (1.0 - coverage) * background, coverage);
-        }
-    } else {
-        for (uint i = pass.first_sample; i < last; i++) {
-            sum += vec4(background, 0.0);
+            sum.rgb += estimate(s, choice, view_terms, fx, fy, fn, sobol_owen_2d(i, env_seed), sobol_owen_2d(i, brdf_seed));
         }
     }
     imageStore(accumulation, pixel, sum);

@@ -17,12 +17,12 @@ macro_rules! kernel {
 pub const RESOLVE: Kernel = kernel!("resolve");
 /// One progressive pass of MIS image-based lighting.
 pub const RELIGHT: Kernel = kernel!("relight");
-/// Mean, exposure, tone map and sRGB encoding.
-pub const DISPLAY: Kernel = kernel!("display");
+/// Mean, composite over the background, and display pixels (exposure, tone map, sRGB).
+pub const FINALIZE: Kernel = kernel!("finalize");
 /// BRDF and pdf evaluation for the GPU-against-CPU tests.
 pub const BRDF_PROBE: Kernel = kernel!("brdf_probe");
 /// Sampling routines and the Sobol sequence, for the chi-square and sequence tests.
 pub const SAMPLE_PROBE: Kernel = kernel!("sample_probe");
 
 /// Every kernel, with the GLSL file it is compiled from (`glsl/<name>.comp`).
-pub const ALL: [&Kernel; 5] = [&RESOLVE, &RELIGHT, &DISPLAY, &BRDF_PROBE, &SAMPLE_PROBE];
+pub const ALL: [&Kernel; 5] = [&RESOLVE, &RELIGHT, &FINALIZE, &BRDF_PROBE, &SAMPLE_PROBE];

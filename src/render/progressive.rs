@@ -4,9 +4,10 @@ use super::Renderer;
 use crate::Result;
 use std::time::{Duration, Instant};
 
-/// How long one dispatch should take: long enough to amortise submission, short enough for a
-/// responsive progress bar and far below any driver watchdog.
-const TARGET_DISPATCH: Duration = Duration::from_millis(200);
+/// How long one dispatch may take: long enough to amortise each pass's per-pixel set-up (on a
+/// CPU driver that set-up costs as much as a couple of samples), short enough for a responsive
+/// progress bar and well below any driver watchdog.
+const TARGET_DISPATCH: Duration = Duration::from_millis(500);
 
 /// What a progressive render measured.
 #[derive(Clone, Copy, Debug, Default)]
@@ -36,10 +37,16 @@ pub fn accumulate(renderer: &mut Renderer, spp: u32, mut progress: impl FnMut(u3
             _ => None,
         };
         progress(renderer.samples());
-        // Aim the next dispatch at the target time, growing at most 4x at a time.
-        let per_sample = elapsed.as_secs_f64() / count as f64;
-        let ideal = (TARGET_DISPATCH.as_secs_f64() / per_sample.max(1e-9)) as u32;
-        batch = ideal.clamp(1, batch.saturating_mul(4));
+        // Grow the batch while dispatches stay under the target. A pass costs a fixed set-up
+        // plus a cost per sample, so the time per sample of a small batch overstates that of a
+        // large one: growing geometrically, rather than by extrapolating, still gets there.
+        if elapsed < TARGET_DISPATCH / 8 {
+            batch = batch.saturating_mul(4);
+        } else if elapsed < TARGET_DISPATCH / 2 {
+            batch = batch.saturating_mul(2);
+        } else if elapsed > TARGET_DISPATCH * 2 {
+            batch = (batch / 2).max(1);
+        }
     }
     stats.wall = start.elapsed();
     Ok(stats)

@@ -44,14 +44,14 @@ struct RelightPush {
     image_width: u32,
 }
 
-/// `Display` in display.comp.
+/// `Finalize` in finalize.comp.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct DisplayPush {
+struct FinalizePush {
     inverse_sample_count: f32,
     exposure_scale: f32,
     tonemap: u32,
-    straight_alpha: u32,
+    show_background: u32,
 }
 
 /// The per-object material inputs on the GPU: which stack each pixel uses, the layers, the masks.
@@ -71,19 +71,21 @@ pub struct Renderer {
     pub height: u32,
     resolve: ComputePipeline,
     relight: ComputePipeline,
-    display: ComputePipeline,
+    finalize: ComputePipeline,
     // Held so the GPU resources that descriptor sets point at stay alive.
     _surface: Image,
     resolved: Image,
-    accumulation: Image,
-    display_image: Image,
+    _accumulation: Image,
+    _background: Image,
+    radiance: Image,
+    display: Image,
     object_ids: Vec<u32>,
     masks: Vec<(String, Vec<f32>)>,
     stacks: Option<GpuStacks>,
     _environment: GpuEnvironment,
     environment_set: DescriptorSet,
     relight_set: DescriptorSet,
-    display_set: DescriptorSet,
+    finalize_set: DescriptorSet,
     timer: Option<GpuTimer>,
     lighting: Lighting,
     seed: u32,
@@ -112,14 +114,14 @@ impl Renderer {
         let relight = ComputePipeline::new(
             ctx,
             &shaders::RELIGHT,
-            &[&[image, image, image], &environment::gpu::SET_LAYOUT],
+            &[&[image, image, image, image], &environment::gpu::SET_LAYOUT],
             std::mem::size_of::<RelightPush>() as u32,
         )?;
-        let display = ComputePipeline::new(
+        let finalize = ComputePipeline::new(
             ctx,
-            &shaders::DISPLAY,
-            &[&[image, image]],
-            std::mem::size_of::<DisplayPush>() as u32,
+            &shaders::FINALIZE,
+            &[&[image; 5]],
+            std::mem::size_of::<FinalizePush>() as u32,
         )?;
 
         let mut surface_data = Vec::with_capacity(3 * gbuffer.pixel_count());
@@ -128,32 +130,53 @@ impl Renderer {
         surface_data.extend(gbuffer.tangent.iter().map(|t| [t[0], t[1], t[2], 0.0]));
         let surface = float_image(ctx, width, height, 3, &surface_data)?;
         let resolved = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 4, true)?;
-        let accumulation = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 1, false)?;
-        let display_image = Image::new(ctx, vk::Format::R8G8B8A8_UNORM, width, height, 1, false)?;
+        let float_target = || Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 1, false);
+        let accumulation = float_target()?;
+        let background = float_target()?;
+        let radiance = float_target()?;
+        let display = Image::new(ctx, vk::Format::R8G8B8A8_UNORM, width, height, 1, false)?;
 
         let gpu_environment = GpuEnvironment::upload(ctx, environment, &Distribution::build(environment))?;
         let environment_set = relight.bind(1, &gpu_environment.bindings())?;
-        let relight_set =
-            relight.bind(0, &[Binding::Image(&surface), Binding::Image(&resolved), Binding::Image(&accumulation)])?;
-        let display_set = display.bind(0, &[Binding::Image(&accumulation), Binding::Image(&display_image)])?;
+        let relight_set = relight.bind(
+            0,
+            &[
+                Binding::Image(&surface),
+                Binding::Image(&resolved),
+                Binding::Image(&accumulation),
+                Binding::Image(&background),
+            ],
+        )?;
+        let finalize_set = finalize.bind(
+            0,
+            &[
+                Binding::Image(&accumulation),
+                Binding::Image(&background),
+                Binding::Image(&surface),
+                Binding::Image(&radiance),
+                Binding::Image(&display),
+            ],
+        )?;
         Ok(Renderer {
             ctx: ctx.clone(),
             width,
             height,
             resolve,
             relight,
-            display,
+            finalize,
             _surface: surface,
             resolved,
-            accumulation,
-            display_image,
+            _accumulation: accumulation,
+            _background: background,
+            radiance,
+            display,
             object_ids: gbuffer.object_id.clone(),
             masks: gbuffer.masks.iter().map(|(k, v)| (k.clone(), v.clone())).collect(),
             stacks: None,
             _environment: gpu_environment,
             environment_set,
             relight_set,
-            display_set,
+            finalize_set,
             timer: GpuTimer::new(ctx, 2)?,
             lighting: Lighting::default(),
             seed: 0,
@@ -276,31 +299,41 @@ impl Renderer {
         Ok(time)
     }
 
-    /// The mean radiance per pixel (rgb) and coverage (a), row 0 at the top.
+    /// Runs finalize.comp: the linear radiance image and the display pixels of the current sums.
+    fn finalize(&self, cmd: vk::CommandBuffer, exposure: f32, tonemap: Tonemap) {
+        let push = FinalizePush {
+            inverse_sample_count: 1.0 / self.samples.max(1) as f32,
+            exposure_scale: exposure.exp2(),
+            tonemap: tonemap.gpu_id(),
+            show_background: self.lighting.background as u32,
+        };
+        let groups = [group_count(self.width, LOCAL_SIZE_X), group_count(self.height, LOCAL_SIZE_Y), 1];
+        self.finalize.dispatch(cmd, &[&self.finalize_set], bytemuck::bytes_of(&push), groups);
+        crate::gpu::context::full_barrier(&self.ctx.device, cmd);
+    }
+
+    /// Linear radiance per pixel, row 0 at the top: rgb composited over the background with
+    /// alpha 1, or, with the background off, premultiplied by coverage with alpha = coverage.
     pub fn read_radiance(&self) -> Result<Vec<[f32; 4]>> {
-        let sums: Vec<[f32; 4]> = bytemuck::cast_slice(&self.accumulation.read(&self.ctx)?).to_vec();
-        let scale = 1.0 / self.samples.max(1) as f32;
-        Ok(sums.iter().map(|s| s.map(|v| v * scale)).collect())
+        let staging = Buffer::staging(&self.ctx, self.radiance.byte_size())?;
+        self.ctx.run(|cmd| {
+            self.finalize(cmd, 0.0, Tonemap::Linear);
+            self.radiance.record_read(cmd, &staging);
+            Ok(())
+        })?;
+        Ok(bytemuck::cast_slice(&staging.bytes()[..self.radiance.byte_size() as usize]).to_vec())
     }
 
     /// Display pixels: exposure, tone map and sRGB, as RGBA8; straight alpha (the coverage) when
     /// the background is off, opaque otherwise.
     pub fn read_display(&self, exposure: f32, tonemap: Tonemap) -> Result<Vec<u8>> {
-        let push = DisplayPush {
-            inverse_sample_count: 1.0 / self.samples.max(1) as f32,
-            exposure_scale: exposure.exp2(),
-            tonemap: tonemap.gpu_id(),
-            straight_alpha: !self.lighting.background as u32,
-        };
-        let groups = [group_count(self.width, LOCAL_SIZE_X), group_count(self.height, LOCAL_SIZE_Y), 1];
-        let staging = Buffer::staging(&self.ctx, self.display_image.byte_size())?;
+        let staging = Buffer::staging(&self.ctx, self.display.byte_size())?;
         self.ctx.run(|cmd| {
-            self.display.dispatch(cmd, &[&self.display_set], bytemuck::bytes_of(&push), groups);
-            crate::gpu::context::full_barrier(&self.ctx.device, cmd);
-            self.display_image.record_read(cmd, &staging);
+            self.finalize(cmd, exposure, tonemap);
+            self.display.record_read(cmd, &staging);
             Ok(())
         })?;
-        Ok(staging.bytes()[..self.display_image.byte_size() as usize].to_vec())
+        Ok(staging.bytes()[..self.display.byte_size() as usize].to_vec())
     }
 
     /// The resolved material per pixel, as four layers of vec4 (for tests and inspection).

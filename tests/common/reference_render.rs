@@ -22,28 +22,41 @@ pub struct Reference<'a> {
 }
 
 impl Reference<'_> {
-    /// The running sum (rgb radiance, a coverage) of pixel (x, y) after `spp` samples, as the
-    /// accumulation image holds it, for a pixel whose resolved material is `params`.
+    /// The final linear radiance of pixel (x, y) after `spp` samples, as `read_radiance` gives
+    /// it, for a pixel whose resolved material is `params`: the mean of the summed estimates,
+    /// composited over the background by coverage (finalize.comp).
     pub fn pixel(&self, x: u32, y: u32, params: &Params, spp: u32) -> Vec4 {
+        let i = (y * self.gbuffer.width + x) as usize;
+        let coverage = self.gbuffer.coverage[i];
+        let mean = if coverage > 0.0 { self.sum(x, y, params, spp) / spp as f32 } else { Vec3::ZERO };
+        if self.lighting.background {
+            (coverage * mean + (1.0 - coverage) * self.background(x, y)).extend(1.0)
+        } else {
+            (coverage * mean).extend(coverage)
+        }
+    }
+
+    /// What the first pass stores as the environment behind pixel (x, y).
+    fn background(&self, x: u32, y: u32) -> Vec3 {
         let g = self.gbuffer;
         let i = (y * g.width + x) as usize;
-        let coverage = g.coverage[i];
+        let rotation = self.lighting.rotation_degrees.to_radians();
+        let to_env = |d: Vec3| environment_from_world(d, rotation.cos(), rotation.sin());
+        if g.coverage[i] < 1.0 {
+            self.lighting.intensity * background(self.env, direction_to_uv(to_env(-Vec3::from(g.view[i]))))
+        } else {
+            Vec3::ZERO
+        }
+    }
+
+    /// The accumulation image's running sum of estimates for a covered pixel.
+    fn sum(&self, x: u32, y: u32, params: &Params, spp: u32) -> Vec3 {
+        let g = self.gbuffer;
+        let i = (y * g.width + x) as usize;
         let view = Vec3::from(g.view[i]);
         let rotation = self.lighting.rotation_degrees.to_radians();
         let (cos_r, sin_r) = (rotation.cos(), rotation.sin());
-        let to_env = |d: Vec3| environment_from_world(d, cos_r, sin_r);
-        let bg = if self.lighting.background && coverage < 1.0 {
-            self.lighting.intensity * background(self.env, direction_to_uv(to_env(-view)))
-        } else {
-            Vec3::ZERO
-        };
-        let mut sum = Vec4::ZERO;
-        if coverage <= 0.0 {
-            for _ in 0..spp {
-                sum += bg.extend(0.0);
-            }
-            return sum;
-        }
+        let mut sum = Vec3::ZERO;
         let n = Vec3::from(g.normal[i]);
         let frame = Frame::new(n, Vec3::from(g.tangent[i]));
         let v = frame.to_local(view);
@@ -58,33 +71,33 @@ impl Reference<'_> {
             let t = texel_of(self.env.width, self.env.height, direction_to_uv(d));
             (Vec3::from(self.env.texel(t.x, t.y)), self.distribution.texel_cell_pdf(t))
         };
+        if v.z <= 0.0 {
+            return sum;
+        }
         for s in 0..spp {
             let mut radiance = Vec3::ZERO;
-            if v.z > 0.0 {
-                let (u_env, u_brdf): (Vec2, Vec2) = (sobol_owen_2d(s, env_seed), sobol_owen_2d(s, brdf_seed));
-                let (d, t) = self.distribution.sample(u_env);
-                let (le, pdf_env) = (Vec3::from(self.env.texel(t.x, t.y)), self.distribution.texel_cell_pdf(t));
-                let l = env_frame.to_local(d);
-                if l.z > 0.0 && pdf_env > 0.0 {
-                    let hv = make_half_vector(&lobes, l, v);
-                    let f = disney_brdf(&lobes, &view_terms, l, &hv);
-                    let pdf_brdf = brdf_pdf(&choice, &view_terms, l, &hv);
-                    radiance += f * (l.z * mis_weight_over_pdf(pdf_env, pdf_brdf)) * le;
-                }
-                let l = sample_brdf(&lobes, &choice, &view_terms, u_brdf);
-                if l.z > 0.0 {
-                    let hv = make_half_vector(&lobes, l, v);
-                    let pdf_brdf = brdf_pdf(&choice, &view_terms, l, &hv);
-                    if pdf_brdf > 0.0 {
-                        let d = env_frame.to_world(l).normalize();
-                        let (le, pdf_env) = texel(d);
-                        let f = disney_brdf(&lobes, &view_terms, l, &hv);
-                        radiance += f * (l.z * mis_weight_over_pdf(pdf_brdf, pdf_env)) * le;
-                    }
-                }
-                radiance *= self.lighting.intensity;
+            let (u_env, u_brdf): (Vec2, Vec2) = (sobol_owen_2d(s, env_seed), sobol_owen_2d(s, brdf_seed));
+            let (d, t) = self.distribution.sample(u_env);
+            let (le, pdf_env) = (Vec3::from(self.env.texel(t.x, t.y)), self.distribution.texel_cell_pdf(t));
+            let l = env_frame.to_local(d);
+            if l.z > 0.0 && pdf_env > 0.0 {
+                let hv = make_half_vector(&lobes, l, v);
+                let f = disney_brdf(&lobes, &view_terms, l, &hv);
+                let pdf_brdf = brdf_pdf(&choice, &view_terms, l, &hv);
+                radiance += f * (l.z * mis_weight_over_pdf(pdf_env, pdf_brdf)) * le;
             }
-            sum += (coverage * radiance + (1.0 - coverage) * bg).extend(coverage);
+            let l = sample_brdf(&lobes, &choice, &view_terms, u_brdf);
+            if l.z > 0.0 {
+                let hv = make_half_vector(&lobes, l, v);
+                let pdf_brdf = brdf_pdf(&choice, &view_terms, l, &hv);
+                if pdf_brdf > 0.0 {
+                    let d = env_frame.to_world(l).normalize();
+                    let (le, pdf_env) = texel(d);
+                    let f = disney_brdf(&lobes, &view_terms, l, &hv);
+                    radiance += f * (l.z * mis_weight_over_pdf(pdf_brdf, pdf_env)) * le;
+                }
+            }
+            sum += radiance * self.lighting.intensity;
         }
         sum
     }
