@@ -460,6 +460,7 @@ fn the_builtin_default_look_shows_layering_on_the_shader_ball() {
     let look = Look::builtin_default();
     assert_eq!(look.file, None);
     assert_eq!(look.render.spp, Some(256));
+    assert_eq!(look.environment.rotation, Some(-90.0));
     assert_eq!(look.mask_names(), ["gradient", "grunge", "stripes"]);
     let ids: Vec<Option<u32>> = look.objects.iter().map(|o| o.id).collect();
     assert_eq!(ids, [None, Some(1), Some(2)]);
@@ -467,8 +468,9 @@ fn the_builtin_default_look_shows_layering_on_the_shader_ball() {
     let ball = &look.stack_for(1).unwrap().layers;
     let presets: Vec<_> = ball.iter().map(|l| l.preset.as_deref().unwrap()).collect();
     assert_eq!(presets, ["blue-rubber", "gold", "grime"]);
+    assert_eq!(ball[0].overrides, [Param::Clearcoat, Param::ClearcoatGloss]);
     assert_eq!(ball[1].mask.as_deref(), Some("stripes"));
-    assert_eq!(ball[1].params.roughness, 0.18);
+    assert_eq!(ball[1].params.roughness, 0.3);
     assert_eq!((ball[2].mask.as_deref(), ball[2].opacity), (Some("grunge"), 0.7));
 
     let pedestal = &look.stack_for(2).unwrap().layers;
