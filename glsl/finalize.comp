@@ -1,5 +1,5 @@
 #version 460
-// Turns the running sums into the image (LOOKDEV.md §6): the mean estimate, composited over the
+// Turns the running sums into the image (README: Output): the mean estimate, composited over the
 // background by coverage, as linear radiance (for EXR); and, through exposure 2^EV, the tone
 // map and the sRGB OETF, as 8-bit display pixels (for PNG and the viewer).
 //

@@ -1,6 +1,6 @@
 #version 460
 // One progressive pass of image-based relighting: for each covered pixel and each sample index,
-// one environment sample and one BRDF sample, combined with the power heuristic (LOOKDEV.md §5).
+// one environment sample and one BRDF sample, combined with the power heuristic (README: Sampling).
 // The running float32 sum of the estimates is accumulated in sample order, so any split into
 // passes gives the same bits. Coverage and the background are composited by finalize.comp, so
 // background pixels cost nothing after the first pass of an accumulation.

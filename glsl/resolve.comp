@@ -1,5 +1,5 @@
 #version 460
-// Resolves each pixel's layer stack into one material, parameter by parameter (LOOKDEV.md §3):
+// Resolves each pixel's layer stack into one material, parameter by parameter (README: Formats):
 // the bottom layer fills, and each layer above blends in with w = clamp(opacity·m, 0, 1), where m
 // is its mask (or 1 − mask when inverted; 1 without a mask). Runs once per edit, not per sample.
 #extension GL_GOOGLE_include_directive : require

@@ -1,4 +1,4 @@
-// The Disney 2012 principled BRDF, BRDF Explorer revision (LOOKDEV.md §4).
+// The Disney 2012 principled BRDF, BRDF Explorer revision (README: Shading model).
 //
 // Every vector is in the shading frame: N = +Z, tangent X = +X, bitangent Y = +Y, so N·W = W.z.
 // What depends only on the material (Lobes) or only on the view (View) is computed once per
@@ -79,7 +79,7 @@ float gtr2_aniso(vec3 h, float ax, float ay) {
     return 1.0 / (PI * ax * ay * d * d);
 }
 
-// Smith G for anisotropic GGX with 1/(4·N·W) folded in: g(W) of LOOKDEV.md §4.
+// Smith G for anisotropic GGX with 1/(4·N·W) folded in: g(W) of the README's shading model.
 float smith_g_aniso(vec3 w, float ax, float ay) {
     float x = w.x * ax;
     float y = w.y * ay;

@@ -1,10 +1,10 @@
-//! The environment's importance-sampling tables (LOOKDEV.md §5).
+//! The environment's importance-sampling tables (README: Sampling).
 //!
 //! Lighting treats the map as piecewise constant over its texels, and sampling draws directions
 //! from a density that is piecewise constant *in solid angle* over cells of texels, with each
 //! cell's probability the integral of luminance over it: Σ luminance·Ω over its texels, where a
-//! texel of row y spans Ω = (2π/W)·(cos θ(y) − cos θ(y+1)). That is the luminance·sinθ weighting
-//! of the brief, integrated exactly, and it makes pdf_ω constant over each cell: the GPU stores it
+//! texel of row y spans Ω = (2π/W)·(cos θ(y) − cos θ(y+1)). That is a luminance·sinθ weighting
+//! integrated exactly over each texel, and it makes pdf_ω constant over each cell: the GPU stores it
 //! beside each texel's radiance, so one fetch gives both and no sinθ is ever divided by.
 //!
 //! Cells are single texels up to [`MAX_CELLS`] texels a side; larger maps use blocks of texels

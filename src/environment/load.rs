@@ -1,4 +1,4 @@
-//! Reading `.exr` and `.hdr` environments, with the checks of LOOKDEV.md §3.
+//! Reading `.exr` and `.hdr` environments, with the checks of the README's formats.
 
 use super::Environment;
 use crate::{Error, Result};

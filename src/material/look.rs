@@ -1,4 +1,4 @@
-//! Looks: what to render. A look file (LOOKDEV.md §3) sets the environment, the render
+//! Looks: what to render. A look file (README: Formats) sets the environment, the render
 //! settings, and one layer stack per object:
 //!
 //! ```toml
@@ -148,7 +148,7 @@ impl Look {
     }
 
     /// The look used for a user g-buffer rendered without a look: every object in the default
-    /// material (LOOKDEV.md §3 defaults: grey 0.8 dielectric, roughness 0.5), default settings.
+    /// material (README: Presets defaults: grey 0.8 dielectric, roughness 0.5), default settings.
     pub fn default_material() -> Look {
         let mut look = Look {
             file: None,

@@ -235,7 +235,7 @@ impl Params {
         }
     }
 
-    /// Per-parameter linear blend, `mix(self, other, w)`: the layer-stack rule of LOOKDEV.md §3.
+    /// Per-parameter linear blend, `mix(self, other, w)`: the layer-stack rule of the README's formats.
     /// Written as `a·(1−w) + b·w`, as `resolve.comp` does, so that w = 1 gives `other` exactly.
     pub fn mix(&self, other: &Params, w: f32) -> Params {
         let a = self.to_gpu();

@@ -90,7 +90,7 @@ pub fn gtr2_aniso(h: Vec3, ax: f32, ay: f32) -> f32 {
     1.0 / (PI * ax * ay * d * d)
 }
 
-/// Smith G for anisotropic GGX with 1/(4·N·W) folded in: g(W) of LOOKDEV.md §4.
+/// Smith G for anisotropic GGX with 1/(4·N·W) folded in: g(W) of the README's shading model.
 pub fn smith_g_aniso(w: Vec3, ax: f32, ay: f32) -> f32 {
     let x = w.x * ax;
     let y = w.y * ay;
