@@ -15,5 +15,8 @@ fn main() {
     let scene = Scene::new(GBuffer::shaderball(size, size), "x".into(), look, Environment::studio(), settings).unwrap();
     let mut r = Renderer::new(&ctx, &scene.gbuffer, &scene.environment).unwrap();
     r.set_stacks(&scene.stacks).unwrap();
-    loop { r.set_seed(r.samples() + 1); r.render_samples(batch).unwrap(); }
+    loop {
+        r.set_seed(r.samples() + 1);
+        r.render_samples(batch).unwrap();
+    }
 }

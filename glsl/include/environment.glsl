@@ -14,10 +14,13 @@
 
 // rgb: radiance; a: pdf over solid angle of the sampling cell that holds the texel.
 layout(set = 1, binding = 0, rgba32f) uniform readonly image2D env_texels;
-// Inverse-CDF tables: row 0 over rows of cells, row 1 + r over the cells of row r. Texel i of a
-// table of n intervals is (cdf[i], cdf[i + 1], guide[i], guide[i + 1]).
-layout(set = 1, binding = 1, rgba32f) uniform readonly image2D env_tables;
-layout(set = 1, binding = 2, std430) readonly buffer EnvInfo {
+// Inverse-CDF tables: row 0 over rows of cells, row 1 + r over the cells of row r. Bucket k of a
+// table is (cdf[g], cdf[g + 1], g, guide[k + 1]) with g = guide[k]: the intervals that values of u
+// in bucket k can fall in run from g to guide[k + 1], and usually that is just g.
+layout(set = 1, binding = 1, rgba32f) uniform readonly image2D env_buckets;
+// The same tables' plain CDF values, for the rare bucket that spans several intervals.
+layout(set = 1, binding = 2, r32f) uniform readonly image2D env_cdf;
+layout(set = 1, binding = 3, std430) readonly buffer EnvInfo {
     uint env_width;    // texels
     uint env_height;
     uint env_block_x;  // texels per cell
@@ -72,21 +75,23 @@ vec3 env_background(vec2 uv) {
 }
 
 // The last interval r of table `table` (n intervals) with cdf[r] <= u, and (cdf[r], cdf[r + 1]).
-// u's bucket's guides bound the answer, usually to a single interval.
 uint env_search(uint table, uint n, float u, out vec2 bounds) {
     uint k = min(uint(u * float(n)), n - 1u);
-    vec4 entry = imageLoad(env_tables, ivec2(k, table));
+    vec4 entry = imageLoad(env_buckets, ivec2(k, table));
     uint lo = uint(entry.z);
     uint hi = uint(entry.w) + 1u;
-    while (hi - lo > 1u) {
-        uint mid = (lo + hi) >> 1;
-        if (imageLoad(env_tables, ivec2(mid, table)).x <= u) {
-            lo = mid;
-        } else {
-            hi = mid;
+    bounds = entry.xy;
+    if (hi - lo > 1u) {
+        while (hi - lo > 1u) {
+            uint mid = (lo + hi) >> 1;
+            if (imageLoad(env_cdf, ivec2(mid, table)).x <= u) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
         }
+        bounds = vec2(imageLoad(env_cdf, ivec2(lo, table)).x, imageLoad(env_cdf, ivec2(lo + 1u, table)).x);
     }
-    bounds = imageLoad(env_tables, ivec2(lo, table)).xy;
     return lo;
 }
 

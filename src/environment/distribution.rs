@@ -18,7 +18,7 @@ use crate::shading::common::luminance;
 use glam::Vec3;
 use std::f64::consts::PI;
 
-/// At most this many cells a side, which bounds the tables at 4096 × 4097 texels.
+/// At most this many cells a side, which bounds the tables at 4097 × 4097 texels.
 pub const MAX_CELLS: u32 = 4096;
 
 /// Sampling tables, laid out as `glsl/include/environment.glsl` reads them.
@@ -89,9 +89,14 @@ impl Table {
         lo
     }
 
-    /// The GPU texels of this table: entry i is (cdf[i], cdf[i+1], guide[i], guide[i+1]).
-    pub fn texels(&self) -> impl Iterator<Item = [f32; 4]> + '_ {
-        (0..self.len()).map(|i| [self.cdf[i], self.cdf[i + 1], self.guide[i] as f32, self.guide[i + 1] as f32])
+    /// The GPU's bucket entries of this table: entry k is (cdf[g], cdf[g + 1], g, guide[k + 1])
+    /// for g = guide[k]. When a bucket holds one interval (g = guide[k + 1]), as it usually does,
+    /// that one fetch is the whole search.
+    pub fn bucket_texels(&self) -> impl Iterator<Item = [f32; 4]> + '_ {
+        (0..self.len()).map(|k| {
+            let g = self.guide[k] as usize;
+            [self.cdf[g], self.cdf[g + 1], g as f32, self.guide[k + 1] as f32]
+        })
     }
 }
 
@@ -203,17 +208,21 @@ impl Distribution {
         out
     }
 
-    /// The tables as one RGBA32F image, `max(rows, columns)` texels wide and `rows + 1` high:
-    /// row 0 the marginal table, row 1 + r the conditional table of row r.
-    pub fn table_texels(&self) -> (u32, u32, Vec<[f32; 4]>) {
-        let width = self.rows.max(self.columns);
-        let mut texels = vec![[0.0f32; 4]; (width * (self.rows + 1)) as usize];
+    /// The tables as two images of `max(rows, columns) + 1` by `rows + 1` texels: the bucket
+    /// entries (RGBA32F) and the plain CDFs (R32F). Row 0 is the marginal table, row 1 + r the
+    /// conditional table of row r.
+    pub fn table_texels(&self) -> (u32, u32, Vec<[f32; 4]>, Vec<f32>) {
+        let width = self.rows.max(self.columns) + 1;
+        let mut buckets = vec![[0.0f32; 4]; (width * (self.rows + 1)) as usize];
+        let mut cdfs = vec![0.0f32; (width * (self.rows + 1)) as usize];
         for (row, table) in std::iter::once(&self.marginal).chain(&self.conditional).enumerate() {
-            for (i, texel) in table.texels().enumerate() {
-                texels[row * width as usize + i] = texel;
+            let start = row * width as usize;
+            for (k, entry) in table.bucket_texels().enumerate() {
+                buckets[start + k] = entry;
             }
+            cdfs[start..start + table.cdf.len()].copy_from_slice(&table.cdf);
         }
-        (width, self.rows + 1, texels)
+        (width, self.rows + 1, buckets, cdfs)
     }
 }
 

@@ -9,7 +9,8 @@ use ash::vk;
 /// environment.
 pub struct GpuEnvironment {
     pub texels: Image,
-    pub tables: Image,
+    pub buckets: Image,
+    pub cdf: Image,
     pub info: Buffer,
 }
 
@@ -26,19 +27,26 @@ impl GpuEnvironment {
         let rgba: Vec<[f32; 4]> =
             env.texels.iter().zip(distribution.texel_pdf()).map(|(t, pdf)| [t[0], t[1], t[2], pdf]).collect();
         texels.upload(ctx, bytemuck::cast_slice(&rgba))?;
-        let (width, height, table_texels) = distribution.table_texels();
-        let tables = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 1, false)?;
-        tables.upload(ctx, bytemuck::cast_slice(&table_texels))?;
+        let (width, height, bucket_texels, cdf_texels) = distribution.table_texels();
+        let buckets = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 1, false)?;
+        buckets.upload(ctx, bytemuck::cast_slice(&bucket_texels))?;
+        let cdf = Image::new(ctx, vk::Format::R32_SFLOAT, width, height, 1, false)?;
+        cdf.upload(ctx, bytemuck::cast_slice(&cdf_texels))?;
         let info = Buffer::with_data(ctx, bytemuck::cast_slice(&distribution.header()))?;
-        Ok(GpuEnvironment { texels, tables, info })
+        Ok(GpuEnvironment { texels, buckets, cdf, info })
     }
 
     /// The bindings of descriptor set 1, in `environment.glsl` order.
-    pub fn bindings(&self) -> [Binding<'_>; 3] {
-        [Binding::Image(&self.texels), Binding::Image(&self.tables), Binding::Buffer(&self.info)]
+    pub fn bindings(&self) -> [Binding<'_>; 4] {
+        [
+            Binding::Image(&self.texels),
+            Binding::Image(&self.buckets),
+            Binding::Image(&self.cdf),
+            Binding::Buffer(&self.info),
+        ]
     }
 }
 
 /// The layout of descriptor set 1.
-pub const SET_LAYOUT: [BindingKind; 3] =
-    [BindingKind::StorageImage, BindingKind::StorageImage, BindingKind::StorageBuffer];
+pub const SET_LAYOUT: [BindingKind; 4] =
+    [BindingKind::StorageImage, BindingKind::StorageImage, BindingKind::StorageImage, BindingKind::StorageBuffer];

@@ -117,12 +117,8 @@ impl Renderer {
             &[&[image, image, image, image], &environment::gpu::SET_LAYOUT],
             std::mem::size_of::<RelightPush>() as u32,
         )?;
-        let finalize = ComputePipeline::new(
-            ctx,
-            &shaders::FINALIZE,
-            &[&[image; 5]],
-            std::mem::size_of::<FinalizePush>() as u32,
-        )?;
+        let finalize =
+            ComputePipeline::new(ctx, &shaders::FINALIZE, &[&[image; 5]], std::mem::size_of::<FinalizePush>() as u32)?;
 
         let mut surface_data = Vec::with_capacity(3 * gbuffer.pixel_count());
         surface_data.extend(gbuffer.normal.iter().zip(&gbuffer.coverage).map(|(n, a)| [n[0], n[1], n[2], *a]));
