@@ -20,6 +20,13 @@ pub struct GpuLayer {
     pub pad: u32,
 }
 
+impl GpuLayer {
+    /// A lone layer of the default parameters, for objects no stack covers.
+    fn default_material() -> GpuLayer {
+        GpuLayer { params: Params::default().to_gpu(), mask: -1, invert: 0, opacity: 1.0, pad: 0 }
+    }
+}
+
 /// One stack as `resolve.comp` reads it: its first layer and how many layers it has.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
@@ -105,13 +112,7 @@ impl PackedStacks {
                 }
                 None => {
                     unstyled.push(id);
-                    packed.layers.push(GpuLayer {
-                        params: Params::default().to_gpu(),
-                        mask: -1,
-                        invert: 0,
-                        opacity: 1.0,
-                        pad: 0,
-                    });
+                    packed.layers.push(GpuLayer::default_material());
                 }
             }
             let layer_count = packed.layers.len() as u32 - first_layer;
@@ -121,13 +122,7 @@ impl PackedStacks {
         // Pixels that shade nothing still index a stack; with no shaded object at all, that is
         // a default-material stack.
         if packed.stacks.is_empty() {
-            packed.layers.push(GpuLayer {
-                params: Params::default().to_gpu(),
-                mask: -1,
-                invert: 0,
-                opacity: 1.0,
-                pad: 0,
-            });
+            packed.layers.push(GpuLayer::default_material());
             packed.stacks.push(GpuStack { first_layer: 0, layer_count: 1, pad: [0; 2] });
         }
         if !unstyled.is_empty() {
