@@ -1,7 +1,10 @@
 //! Writing files so that an existing file is never left half-written: the bytes go to a
-//! temporary file in the same folder, which is then renamed over the target in one step.
+//! temporary file in the same folder, which is then renamed over the target in one step. A
+//! write that fails, or a process killed mid-write, leaves the old file as it was (and at worst a
+//! hidden temporary file beside it).
 
 use crate::{Error, Result};
+use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -12,17 +15,83 @@ fn temporary_path(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
-/// Writes `bytes` to `path` atomically.
+/// Writes `bytes` to `path` atomically, replacing any existing file.
 pub fn write(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_with(path, true, |file| file.write_all(bytes))
+}
+
+/// Writes `bytes` to `path` atomically, failing if `path` already exists: the check and the
+/// write are one step, so a file that appears meanwhile is not overwritten either.
+pub fn write_new(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_with(path, false, |file| file.write_all(bytes))
+}
+
+/// Fills a temporary file with `fill`, syncs it, then puts it at `path`: by rename (replacing)
+/// or by hard link (only if `path` does not exist). On any failure the temporary file is
+/// removed and `path` is untouched.
+pub fn write_with(path: &Path, replace: bool, fill: impl FnOnce(&mut File) -> std::io::Result<()>) -> Result<()> {
     let temporary = temporary_path(path);
     let result = (|| {
-        let mut file = std::fs::File::create(&temporary)?;
-        file.write_all(bytes)?;
+        let mut file = File::create(&temporary)?;
+        fill(&mut file)?;
         file.sync_all()?;
-        std::fs::rename(&temporary, path)
+        drop(file);
+        if replace {
+            std::fs::rename(&temporary, path)
+        } else {
+            std::fs::hard_link(&temporary, path).and_then(|()| std::fs::remove_file(&temporary))
+        }
     })();
     result.map_err(|e| {
         let _ = std::fs::remove_file(&temporary);
-        Error::io(path, format!("cannot write: {e}"))
+        if e.kind() == std::io::ErrorKind::AlreadyExists {
+            Error::input_file(path, "already exists (--force replaces it)")
+        } else {
+            Error::io(path, format!("cannot write: {e}"))
+        }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_failed_write_leaves_the_old_file_and_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("look.toml");
+        std::fs::write(&path, "old contents").unwrap();
+        let failed = write_with(&path, true, |file| {
+            file.write_all(b"half a new fi")?;
+            Err(std::io::Error::other("disk full"))
+        });
+        assert!(failed.is_err());
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "old contents");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "the temporary file was removed");
+        write(&path, b"new contents").unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "new contents");
+    }
+
+    #[test]
+    fn a_leftover_temporary_from_a_killed_write_changes_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("gold.toml");
+        std::fs::write(&path, "old").unwrap();
+        // What a process killed between writing and renaming leaves behind.
+        std::fs::write(temporary_path(&path), "partial").unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "old");
+        write(&path, b"new").unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "new");
+    }
+
+    #[test]
+    fn write_new_refuses_an_existing_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.toml");
+        write_new(&path, b"first").unwrap();
+        let error = write_new(&path, b"second").unwrap_err();
+        assert!(error.message.contains("already exists"), "{}", error.message);
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "first");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
 }

@@ -16,6 +16,8 @@ pub enum ErrorKind {
     Gpu,
     /// Reading or writing failed for a reason that is not the input's fault. Exit code 1.
     Io,
+    /// `lookdev lint` found implausible values (already printed). Exit code 1.
+    Lint,
 }
 
 /// A one-line, user-facing error.
@@ -42,6 +44,10 @@ impl Error {
         Error { kind: ErrorKind::Gpu, message: problem.to_string() }
     }
 
+    pub fn lint(summary: impl fmt::Display) -> Self {
+        Error { kind: ErrorKind::Lint, message: summary.to_string() }
+    }
+
     pub fn io(file: impl AsRef<Path>, problem: impl fmt::Display) -> Self {
         Error { kind: ErrorKind::Io, message: format!("{}: {}", file.as_ref().display(), problem) }
     }
@@ -50,7 +56,7 @@ impl Error {
     pub fn exit_code(&self) -> i32 {
         match self.kind {
             ErrorKind::Input => 2,
-            ErrorKind::Gpu | ErrorKind::Io => 1,
+            ErrorKind::Gpu | ErrorKind::Io | ErrorKind::Lint => 1,
         }
     }
 }

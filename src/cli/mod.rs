@@ -2,8 +2,12 @@
 
 mod bench;
 mod gbuffer;
+mod lint;
+mod presets;
 mod progress;
 mod render;
+mod turntable;
+mod wedge;
 
 use crate::gpu::ContextOptions;
 use crate::material::params::{parse_value, Param, Value};
@@ -24,6 +28,14 @@ pub enum Command {
     Render(render::RenderArgs),
     /// Write the built-in look-dev g-buffer to an EXR.
     Gbuffer(gbuffer::GbufferArgs),
+    /// The preset library: list, show, save, and a contact sheet of every preset.
+    Presets(presets::PresetsArgs),
+    /// Render a look once per value of a parameter, as labelled rows.
+    Wedge(wedge::WedgeArgs),
+    /// Render the look with the environment turning through 360°, one image per frame.
+    Turntable(turntable::TurntableArgs),
+    /// Check a look's materials for implausible values.
+    Lint(lint::LintArgs),
     /// Measure relighting throughput on the built-in scene.
     Bench(bench::BenchArgs),
     /// List the Vulkan devices lookdev can use, best first.
@@ -47,6 +59,10 @@ pub fn run(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<()> {
     match cli.command {
         Command::Render(args) => render::run(args),
         Command::Gbuffer(args) => gbuffer::run(args),
+        Command::Presets(args) => presets::run(args),
+        Command::Wedge(args) => wedge::run(args),
+        Command::Turntable(args) => turntable::run(args),
+        Command::Lint(args) => lint::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Devices => list_devices(),
     }

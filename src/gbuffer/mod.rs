@@ -62,6 +62,8 @@ mod validate;
 mod write;
 
 pub use frame::stable_tangent;
+/// Object ids of the built-in scene.
+pub use scene::{BALL_ID, PEDESTAL_ID};
 
 use std::collections::BTreeMap;
 

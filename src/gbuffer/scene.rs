@@ -7,10 +7,10 @@
 use glam::Vec3;
 
 /// Object 1: the unit ball, centred at the origin (and so at the image centre).
-pub(crate) const BALL_ID: u32 = 1;
+pub const BALL_ID: u32 = 1;
 pub(crate) const BALL_NAME: &str = "ball";
 /// Object 2: the pedestal under the ball.
-pub(crate) const PEDESTAL_ID: u32 = 2;
+pub const PEDESTAL_ID: u32 = 2;
 pub(crate) const PEDESTAL_NAME: &str = "pedestal";
 
 const BALL_RADIUS: f32 = 1.0;

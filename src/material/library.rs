@@ -4,16 +4,36 @@
 //!
 //! 1. If it looks like a path (it contains `/` or `\`, or ends with `.toml`), it is a preset file,
 //!    relative to the look file's folder; absolute paths work too.
-//! 2. Otherwise it is a name, looked up as `<folder>/<name>.toml` in each search folder in turn
-//!    (today only the look file's folder), then among the built-in presets.
+//! 2. Otherwise it is a name, looked up as `<folder>/<name>.toml` in the look file's folder, then
+//!    in the user library ([`user_library_dir`]), then among the built-in presets.
 //!
-//! The built-in presets are the files in `presets/`, compiled into the binary. A user library
-//! slots in as another search folder after the look's folder ([`Library::with_search_dir`]).
+//! A user preset with the name of a built-in one shadows it; that is reported once per process.
+//! The built-in presets are the files in `presets/`, compiled into the binary.
 
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use super::preset::Preset;
 use super::toml_input::closest;
+
+/// The user's preset library: `$LOOKDEV_PRESETS` if set, else `$XDG_DATA_HOME/lookdev/presets`,
+/// else `~/.local/share/lookdev/presets`. None only without any of those variables.
+pub fn user_library_dir() -> Option<PathBuf> {
+    let var = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty()).map(PathBuf::from);
+    var("LOOKDEV_PRESETS")
+        .or_else(|| var("XDG_DATA_HOME").map(|d| d.join("lookdev").join("presets")))
+        .or_else(|| var("HOME").map(|h| h.join(".local/share/lookdev/presets")))
+}
+
+/// Names already reported as shadowing a built-in preset, so each is reported once.
+static REPORTED_SHADOWS: Mutex<BTreeSet<String>> = Mutex::new(BTreeSet::new());
+
+fn report_shadowing(name: &str, path: &Path) {
+    if builtin(name).is_some() && REPORTED_SHADOWS.lock().is_ok_and(|mut seen| seen.insert(name.to_string())) {
+        crate::warn(format!("{}: user preset '{name}' shadows the built-in one", path.display()));
+    }
+}
 
 /// The built-in presets: every file in `presets/`, by name (the file name without `.toml`).
 /// A test fails if this list and the folder disagree.
@@ -67,10 +87,17 @@ impl Library {
         Library::default()
     }
 
-    /// The library a look file sees: its own folder first, then the built-ins.
+    /// The user library, then the built-ins: what `lookdev presets` sees.
+    pub fn standard() -> Library {
+        Library { base: PathBuf::new(), search: user_library_dir().into_iter().collect() }
+    }
+
+    /// The library a look file sees: its own folder, then the user library, then the built-ins.
     pub fn for_look(look_file: &Path) -> Library {
         let folder = look_file.parent().map(Path::to_path_buf).unwrap_or_default();
-        Library { base: folder.clone(), search: vec![folder] }
+        let mut search = vec![folder.clone()];
+        search.extend(user_library_dir().filter(|dir| *dir != folder));
+        Library { base: folder, search }
     }
 
     /// Adds a folder to search for names after those already present (for a user library).
@@ -86,13 +113,42 @@ impl Library {
         if looks_like_path(reference) {
             return load(reference, &self.base.join(reference));
         }
-        for dir in &self.search {
-            let path = dir.join(format!("{reference}.toml"));
-            if path.is_file() {
-                return load(reference, &path);
+        if let Some(path) = self.find(reference) {
+            if user_library_dir().is_some_and(|dir| path.parent() == Some(dir.as_path())) {
+                report_shadowing(reference, &path);
             }
+            return load(reference, &path);
         }
         builtin(reference).ok_or_else(|| self.unknown(reference))
+    }
+
+    /// The file a name resolves to in the search folders, if any.
+    pub fn find(&self, name: &str) -> Option<PathBuf> {
+        self.search.iter().map(|dir| dir.join(format!("{name}.toml"))).find(|path| path.is_file())
+    }
+
+    /// Every preset the library can resolve by name, with where it comes from: the search
+    /// folders' files first (a name found earlier shadows later ones), then the built-ins not
+    /// shadowed. Files that fail to load are returned as errors, not skipped.
+    pub fn entries(&self) -> Vec<(String, Origin, Result<Preset, String>)> {
+        let mut out: Vec<(String, Origin, Result<Preset, String>)> = Vec::new();
+        for dir in &self.search {
+            for name in toml_stems(dir) {
+                if out.iter().any(|(n, _, _)| *n == name) {
+                    continue;
+                }
+                let path = dir.join(format!("{name}.toml"));
+                let preset = load(&name, &path);
+                out.push((name, Origin::File(path), preset));
+            }
+        }
+        for name in builtin_names() {
+            if !out.iter().any(|(n, _, _)| n == name) {
+                out.push((name.to_string(), Origin::Builtin, Ok(builtin(name).expect("listed"))));
+            }
+        }
+        out.sort_by(|a, b| a.0.cmp(&b.0));
+        out
     }
 
     fn unknown(&self, name: &str) -> String {
@@ -107,23 +163,37 @@ impl Library {
     fn names(&self) -> Vec<String> {
         let mut names: Vec<String> = builtin_names().into_iter().map(String::from).collect();
         for dir in &self.search {
-            // A look given as a bare file name has the empty path as its folder.
-            let dir = if dir.as_os_str().is_empty() { Path::new(".") } else { dir.as_path() };
-            let Ok(entries) = std::fs::read_dir(dir) else {
-                continue;
-            };
-            for path in entries.flatten().map(|e| e.path()) {
-                if path.extension().is_some_and(|e| e == "toml") {
-                    if let Some(stem) = path.file_stem() {
-                        names.push(stem.to_string_lossy().into_owned());
-                    }
-                }
-            }
+            names.extend(toml_stems(dir));
         }
         names.sort();
         names.dedup();
         names
     }
+}
+
+/// Where a preset comes from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Origin {
+    File(PathBuf),
+    Builtin,
+}
+
+/// The stems of the `*.toml` files in a folder, sorted; an unreadable folder has none.
+fn toml_stems(dir: &Path) -> Vec<String> {
+    // A look given as a bare file name has the empty path as its folder.
+    let dir = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
+    let mut stems: Vec<String> = std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .flatten()
+                .map(|e| e.path())
+                .filter(|p| p.is_file() && p.extension().is_some_and(|e| e == "toml"))
+                .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
+                .collect()
+        })
+        .unwrap_or_default();
+    stems.sort();
+    stems
 }
 
 fn load(reference: &str, path: &Path) -> Result<Preset, String> {
@@ -186,7 +256,7 @@ mod tests {
     #[test]
     fn metal_base_colors_are_f0_of_the_cited_complex_ior() {
         let metals: [(&str, [(f64, f64); 3]); 5] = [
-            // Johnson & Christy 1972 at 659.5 nm and 450.9 nm; the seed's 546.1 nm value for G.
+            // Johnson & Christy 1972 at 659.5 nm and 450.9 nm; Ogaki and Ishiyama's 546.1 nm value for G.
             ("gold", [(0.14, 3.697), (0.31, 2.34), (1.38, 1.914)]),
             ("silver", [(0.05, 4.483), (0.05, 3.54), (0.04, 2.657)]),
             ("copper", [(0.22, 3.747), (0.84, 2.41), (1.24, 2.397)]),

@@ -1,10 +1,12 @@
 //! Rendering: parameter resolve, progressive relighting, accumulation and display transforms.
 
+pub mod batch;
 pub mod output;
 pub mod progressive;
 pub mod renderer;
 pub mod scene;
 pub mod settings;
+pub mod sheet;
 pub mod tonemap;
 
 pub use renderer::{KernelTimes, Lighting, Renderer};

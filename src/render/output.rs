@@ -56,3 +56,11 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[u8], with_alpha: 
     encoded.map_err(|e| Error::io(path, format!("cannot encode the PNG ({e})")))?;
     atomic_file::write(path, bytes.get_ref())
 }
+
+/// Writes an RGBA8 image (a contact sheet, a wedge) as a PNG, atomically.
+pub fn write_png_image(path: &Path, image: &image::RgbaImage) -> Result<()> {
+    if OutputFormat::from_path(path)? != OutputFormat::Png {
+        return Err(Error::input_file(path, "this output is a .png file"));
+    }
+    write_png(path, image.width(), image.height(), image.as_raw(), true)
+}

@@ -1,0 +1,284 @@
+//! `lookdev presets list | show | save | sheet`: the preset library.
+
+use super::progress::Progress;
+use crate::environment::{self, Environment, LoadOptions};
+use crate::gbuffer::GBuffer;
+use crate::material::library::{self, Library, Origin};
+use crate::material::look::{Layer, Look, ObjectStack};
+use crate::material::params::{Param, Params};
+use crate::material::Preset;
+use crate::render::batch::Batch;
+use crate::render::settings::{Overrides, Settings};
+use crate::render::sheet::{self, Cell};
+use crate::{atomic_file, Error, Result};
+use clap::{Args, Subcommand};
+use std::path::{Path, PathBuf};
+
+#[derive(Args, Debug)]
+pub struct PresetsArgs {
+    #[command(subcommand)]
+    pub command: PresetsCommand,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum PresetsCommand {
+    /// One line per preset: name, tags, and the first sentence of its description.
+    List {
+        /// Only presets with this tag.
+        #[arg(long)]
+        tag: Option<String>,
+    },
+    /// A preset's resolved values (every parameter) and where it comes from.
+    Show { name: String },
+    /// Save a preset to the user library, from a look's layer or from parameter values.
+    Save(SaveArgs),
+    /// Render every preset on the built-in ball under the same light, as a labelled grid.
+    Sheet(SheetArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct SaveArgs {
+    /// The preset's name: lowercase letters, digits, '-' and '_'.
+    pub name: String,
+    /// Take the parameters of a look's layer (with --object and --layer).
+    #[arg(long, value_name = "FILE.toml", requires_all = ["object", "layer"], conflicts_with = "set")]
+    pub from_look: Option<PathBuf>,
+    /// The object whose stack holds the layer: its id, or "default" for the default stack.
+    #[arg(long, value_name = "ID")]
+    pub object: Option<String>,
+    /// The layer, counted from 0 at the bottom of the stack.
+    #[arg(long, value_name = "N")]
+    pub layer: Option<usize>,
+    /// Parameter values over the defaults, e.g. --set roughness=0.3.
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+    #[arg(long, default_value = "")]
+    pub description: String,
+    /// Comma-separated tags.
+    #[arg(long, value_delimiter = ',')]
+    pub tags: Vec<String>,
+    /// Replace an existing preset of this name.
+    #[arg(long)]
+    pub force: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct SheetArgs {
+    #[arg(long, value_name = "FILE.png")]
+    pub out: PathBuf,
+    /// Only presets with this tag.
+    #[arg(long)]
+    pub tag: Option<String>,
+    #[arg(long, value_name = "FILE.exr|.hdr")]
+    pub env: Option<PathBuf>,
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    pub rotation: Option<f32>,
+    #[arg(long, default_value_t = 128)]
+    pub spp: u32,
+    /// Side of each render in pixels.
+    #[arg(long, default_value_t = 192)]
+    pub size: u32,
+    /// Columns of the grid (default: about square).
+    #[arg(long)]
+    pub columns: Option<usize>,
+    #[arg(long, value_name = "NAME")]
+    pub device: Option<String>,
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+pub fn run(args: PresetsArgs) -> Result<()> {
+    match args.command {
+        PresetsCommand::List { tag } => list(tag.as_deref()),
+        PresetsCommand::Show { name } => show(&name),
+        PresetsCommand::Save(args) => save(args),
+        PresetsCommand::Sheet(args) => sheet(args),
+    }
+}
+
+/// Every preset the standard library resolves, optionally with a tag; broken files are errors.
+fn presets_with_tag(tag: Option<&str>) -> Result<Vec<(Preset, Origin)>> {
+    let mut out = Vec::new();
+    for (_, origin, preset) in Library::standard().entries() {
+        let preset = preset.map_err(Error::input)?;
+        if tag.is_none_or(|t| preset.tags.iter().any(|p| p == t)) {
+            out.push((preset, origin));
+        }
+    }
+    if let (Some(tag), true) = (tag, out.is_empty()) {
+        return Err(Error::input(format!("--tag {tag}: no preset has this tag")));
+    }
+    Ok(out)
+}
+
+/// The first sentence of a description, for one-line listings.
+fn first_sentence(text: &str) -> &str {
+    let text = text.trim();
+    match text.find(". ") {
+        Some(end) => &text[..=end],
+        None => text,
+    }
+}
+
+fn list(tag: Option<&str>) -> Result<()> {
+    let presets = presets_with_tag(tag)?;
+    let width = presets.iter().map(|(p, _)| p.name.len()).max().unwrap_or(0);
+    for (preset, origin) in presets {
+        let mark = if origin == Origin::Builtin { "" } else { " (user)" };
+        println!(
+            "{:width$}  [{}]{mark}  {}",
+            preset.name,
+            preset.tags.join(", "),
+            first_sentence(&preset.description)
+        );
+    }
+    Ok(())
+}
+
+fn show(name: &str) -> Result<()> {
+    let library = Library::standard();
+    let preset = library.resolve(name).map_err(Error::input)?;
+    let origin = match library.find(name) {
+        Some(path) => path.display().to_string(),
+        None => "built-in".to_string(),
+    };
+    println!("name = {}", preset.name);
+    println!("source = {origin}");
+    println!("tags = [{}]", preset.tags.join(", "));
+    println!("description = {}", preset.description.trim());
+    for param in Param::ALL {
+        let mark = if preset.set.contains(&param) { "" } else { "  # default" };
+        println!("{param} = {}{mark}", preset.params.get(param));
+    }
+    Ok(())
+}
+
+fn valid_name(name: &str) -> bool {
+    !name.is_empty() && name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '_')
+}
+
+fn save(args: SaveArgs) -> Result<()> {
+    if !valid_name(&args.name) {
+        return Err(Error::input(format!(
+            "'{}' is not a preset name: use lowercase letters, digits, '-' and '_'",
+            args.name
+        )));
+    }
+    let dir = library::user_library_dir()
+        .ok_or_else(|| Error::input("no user library: set LOOKDEV_PRESETS or HOME"))?;
+    let (params, set) = match &args.from_look {
+        Some(look) => layer_params(look, args.object.as_deref().unwrap_or_default(), args.layer.unwrap_or(0))?,
+        None if args.set.is_empty() => {
+            return Err(Error::input("presets save needs --from-look FILE --object ID --layer N, or --set NAME=VALUE"))
+        }
+        None => {
+            let mut params = Params::default();
+            let mut set = Vec::new();
+            for text in &args.set {
+                let (param, value) = super::parse_set(text)?;
+                params.set(param, value).map_err(Error::input)?;
+                set.push(param);
+            }
+            (params, set)
+        }
+    };
+    let mut set: Vec<Param> = Param::ALL.into_iter().filter(|p| set.contains(p)).collect();
+    set.dedup();
+    let preset = Preset { name: args.name.clone(), description: args.description, tags: args.tags, params, set };
+    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, format!("cannot create the user library: {e}")))?;
+    let path = dir.join(format!("{}.toml", args.name));
+    let text = preset.to_toml();
+    if args.force {
+        atomic_file::write(&path, text.as_bytes())?;
+    } else {
+        atomic_file::write_new(&path, text.as_bytes())?;
+    }
+    println!("{}", path.display());
+    Ok(())
+}
+
+/// The resolved parameters of one layer of a look (its preset with its overrides), and which
+/// parameters differ from the defaults.
+fn layer_params(look_path: &Path, object: &str, layer: usize) -> Result<(Params, Vec<Param>)> {
+    let look = Look::load(look_path)?;
+    let id = match object {
+        "default" => None,
+        text => Some(text.parse::<u32>().map_err(|_| {
+            Error::input(format!("--object {text}: expected an object id or \"default\""))
+        })?),
+    };
+    let stack = look
+        .objects
+        .iter()
+        .find(|o| o.id == id)
+        .ok_or_else(|| Error::input_file(look_path, format!("no stack for object {object}")))?;
+    let chosen: &Layer = stack.layers.get(layer).ok_or_else(|| {
+        Error::input_file(look_path, format!("object {object} has {} layers; --layer {layer} is not one", stack.layers.len()))
+    })?;
+    let defaults = Params::default();
+    let set = Param::ALL.into_iter().filter(|p| chosen.params.get(*p) != defaults.get(*p)).collect();
+    Ok((chosen.params, set))
+}
+
+/// The look of one contact-sheet cell: the preset on the ball, a neutral mid-grey pedestal.
+fn preset_on_ball(preset: &Preset) -> Look {
+    let layer = |params: Params| Layer {
+        preset: None,
+        params,
+        overrides: Vec::new(),
+        mask: None,
+        invert: false,
+        opacity: 1.0,
+        line: 0,
+    };
+    let pedestal = Params { base_color: [0.18; 3], roughness: 0.6, ..Params::default() };
+    let mut look = Look::default_material();
+    look.objects = vec![
+        ObjectStack { id: None, layers: vec![layer(pedestal)] },
+        ObjectStack { id: Some(crate::gbuffer::BALL_ID), layers: vec![layer(preset.params)] },
+    ];
+    look
+}
+
+fn sheet(args: SheetArgs) -> Result<()> {
+    if args.spp == 0 {
+        return Err(Error::input("--spp 0: the sample count must be at least 1"));
+    }
+    if !(16..=2048).contains(&args.size) {
+        return Err(Error::input(format!("--size {}: renders must be 16 to 2048 pixels", args.size)));
+    }
+    let presets = presets_with_tag(args.tag.as_deref())?;
+    let environment = match &args.env {
+        Some(path) => environment::load::load(path, &LoadOptions::default())?,
+        None => Environment::studio(),
+    };
+    let base = Look::builtin_default();
+    let overrides = Overrides { rotation: args.rotation, spp: Some(args.spp), ..Overrides::default() };
+    let settings = Settings::resolve(&base, &overrides)?;
+    let gbuffer = GBuffer::shaderball(args.size, args.size);
+    let ctx = super::context(args.device.clone())?;
+    let counter = ctx.validation_counter();
+    let cells = {
+        let mut batch = Batch::new(&ctx, &gbuffer, Path::new("built-in shader ball"), &environment)?;
+        let mut progress = Progress::new(presets.len() as u64, "presets", args.quiet);
+        let mut cells = Vec::new();
+        for (i, (preset, origin)) in presets.iter().enumerate() {
+            batch.render(&preset_on_ball(preset), &settings, |_| {})?;
+            let pixels = batch.display(&settings)?;
+            let image = image::RgbaImage::from_raw(args.size, args.size, pixels).expect("size matches");
+            let mut caption = preset.tags.join(", ");
+            if *origin != Origin::Builtin {
+                caption = format!("user · {caption}");
+            }
+            cells.push(Cell { image, title: preset.name.clone(), caption });
+            progress.update(i as u64 + 1);
+        }
+        progress.finish();
+        cells
+    };
+    drop(ctx);
+    super::check_validation(&counter)?;
+    let columns = args.columns.unwrap_or_else(|| (cells.len() as f64).sqrt().ceil() as usize).max(1);
+    let image = sheet::grid(&cells, columns);
+    crate::render::output::write_png_image(&args.out, &image)
+}

@@ -1,0 +1,57 @@
+//! Many renders of one g-buffer under one environment, each with its own look: contact sheets,
+//! wedges and turntables. The renderer, g-buffer and environment are set up once.
+
+use super::progressive;
+use super::scene::covered_object_ids;
+use super::settings::Settings;
+use super::Renderer;
+use crate::environment::Environment;
+use crate::gbuffer::GBuffer;
+use crate::gpu::Context;
+use crate::material::stack::PackedStacks;
+use crate::material::Look;
+use crate::Result;
+use std::path::Path;
+
+/// A renderer kept across renders of different looks and settings.
+pub struct Batch<'a> {
+    renderer: Renderer,
+    gbuffer: &'a GBuffer,
+    gbuffer_name: &'a Path,
+}
+
+impl<'a> Batch<'a> {
+    pub fn new(ctx: &Context, gbuffer: &'a GBuffer, gbuffer_name: &'a Path, environment: &Environment) -> Result<Batch<'a>> {
+        Ok(Batch { renderer: Renderer::new(ctx, gbuffer, environment)?, gbuffer, gbuffer_name })
+    }
+
+    pub fn width(&self) -> u32 {
+        self.gbuffer.width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.gbuffer.height
+    }
+
+    /// Renders `look` with `settings` (environment file excepted: the batch's is fixed) to
+    /// `settings.spp`, calling `progress(samples)` after each pass.
+    pub fn render(&mut self, look: &Look, settings: &Settings, progress: impl FnMut(u32)) -> Result<()> {
+        let masks: Vec<String> = self.gbuffer.masks.keys().cloned().collect();
+        let stacks = PackedStacks::pack(look, covered_object_ids(self.gbuffer), &masks, self.gbuffer_name)?;
+        self.renderer.set_stacks(&stacks)?;
+        self.renderer.set_lighting(settings.lighting);
+        self.renderer.set_seed(settings.seed);
+        progressive::accumulate(&mut self.renderer, settings.spp, progress)?;
+        Ok(())
+    }
+
+    /// The last render as display pixels (RGBA8).
+    pub fn display(&self, settings: &Settings) -> Result<Vec<u8>> {
+        self.renderer.read_display(settings.exposure, settings.tonemap)
+    }
+
+    /// The last render as linear radiance.
+    pub fn radiance(&self) -> Result<Vec<[f32; 4]>> {
+        self.renderer.read_radiance()
+    }
+}
