@@ -125,12 +125,7 @@ fn list(tag: Option<&str>) -> Result<()> {
     let width = presets.iter().map(|(p, _)| p.name.len()).max().unwrap_or(0);
     for (preset, origin) in presets {
         let mark = if origin == Origin::Builtin { "" } else { " (user)" };
-        println!(
-            "{:width$}  [{}]{mark}  {}",
-            preset.name,
-            preset.tags.join(", "),
-            first_sentence(&preset.description)
-        );
+        println!("{:width$}  [{}]{mark}  {}", preset.name, preset.tags.join(", "), first_sentence(&preset.description));
     }
     Ok(())
 }
@@ -164,8 +159,8 @@ fn save(args: SaveArgs) -> Result<()> {
             args.name
         )));
     }
-    let dir = library::user_library_dir()
-        .ok_or_else(|| Error::input("no user library: set LOOKDEV_PRESETS or HOME"))?;
+    let dir =
+        library::user_library_dir().ok_or_else(|| Error::input("no user library: set LOOKDEV_PRESETS or HOME"))?;
     let (params, set) = match &args.from_look {
         Some(look) => layer_params(look, args.object.as_deref().unwrap_or_default(), args.layer.unwrap_or(0))?,
         None if args.set.is_empty() => {
@@ -203,9 +198,10 @@ fn layer_params(look_path: &Path, object: &str, layer: usize) -> Result<(Params,
     let look = Look::load(look_path)?;
     let id = match object {
         "default" => None,
-        text => Some(text.parse::<u32>().map_err(|_| {
-            Error::input(format!("--object {text}: expected an object id or \"default\""))
-        })?),
+        text => Some(
+            text.parse::<u32>()
+                .map_err(|_| Error::input(format!("--object {text}: expected an object id or \"default\"")))?,
+        ),
     };
     let stack = look
         .objects
@@ -213,7 +209,10 @@ fn layer_params(look_path: &Path, object: &str, layer: usize) -> Result<(Params,
         .find(|o| o.id == id)
         .ok_or_else(|| Error::input_file(look_path, format!("no stack for object {object}")))?;
     let chosen: &Layer = stack.layers.get(layer).ok_or_else(|| {
-        Error::input_file(look_path, format!("object {object} has {} layers; --layer {layer} is not one", stack.layers.len()))
+        Error::input_file(
+            look_path,
+            format!("object {object} has {} layers; --layer {layer} is not one", stack.layers.len()),
+        )
     })?;
     let defaults = Params::default();
     let set = Param::ALL.into_iter().filter(|p| chosen.params.get(*p) != defaults.get(*p)).collect();

@@ -107,7 +107,9 @@ pub fn run(args: TurntableArgs) -> Result<()> {
             progress.finish();
             let path = pattern.path(frame);
             match format {
-                OutputFormat::Exr => output::write_exr(&path, width, height, &batch.radiance()?, settings.lighting.background)?,
+                OutputFormat::Exr => {
+                    output::write_exr(&path, width, height, &batch.radiance()?, settings.lighting.background)?
+                }
                 OutputFormat::Png => {
                     output::write_png(&path, width, height, &batch.display(&settings)?, !settings.lighting.background)?
                 }

@@ -109,7 +109,8 @@ pub fn run(args: WedgeArgs) -> Result<()> {
             row_look.ensure_default_stack();
             let mut title = param.name().to_string();
             if let Some(other) = enabler(param) {
-                let off = row_look.objects.iter().flat_map(|o| &o.layers).all(|l| l.params.get(other) == Value::Scalar(0.0));
+                let off =
+                    row_look.objects.iter().flat_map(|o| &o.layers).all(|l| l.params.get(other) == Value::Scalar(0.0));
                 if off {
                     row_look.set_everywhere(other, Value::Scalar(1.0));
                     title = format!("{title} ({other} 1)");

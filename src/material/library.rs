@@ -79,6 +79,8 @@ pub struct Library {
     base: PathBuf,
     /// Folders searched for `<name>.toml`, in order, before the built-ins.
     search: Vec<PathBuf>,
+    /// The look file itself, which is never a preset even when its name matches one.
+    look: Option<PathBuf>,
 }
 
 impl Library {
@@ -89,7 +91,7 @@ impl Library {
 
     /// The user library, then the built-ins: what `lookdev presets` sees.
     pub fn standard() -> Library {
-        Library { base: PathBuf::new(), search: user_library_dir().into_iter().collect() }
+        Library { base: PathBuf::new(), search: user_library_dir().into_iter().collect(), look: None }
     }
 
     /// The library a look file sees: its own folder, then the user library, then the built-ins.
@@ -97,7 +99,7 @@ impl Library {
         let folder = look_file.parent().map(Path::to_path_buf).unwrap_or_default();
         let mut search = vec![folder.clone()];
         search.extend(user_library_dir().filter(|dir| *dir != folder));
-        Library { base: folder, search }
+        Library { base: folder, search, look: Some(look_file.to_path_buf()) }
     }
 
     /// Adds a folder to search for names after those already present (for a user library).
@@ -124,7 +126,10 @@ impl Library {
 
     /// The file a name resolves to in the search folders, if any.
     pub fn find(&self, name: &str) -> Option<PathBuf> {
-        self.search.iter().map(|dir| dir.join(format!("{name}.toml"))).find(|path| path.is_file())
+        self.search
+            .iter()
+            .map(|dir| dir.join(format!("{name}.toml")))
+            .find(|path| path.is_file() && self.look.as_deref() != Some(path.as_path()))
     }
 
     /// Every preset the library can resolve by name, with where it comes from: the search

@@ -21,7 +21,12 @@ pub struct Batch<'a> {
 }
 
 impl<'a> Batch<'a> {
-    pub fn new(ctx: &Context, gbuffer: &'a GBuffer, gbuffer_name: &'a Path, environment: &Environment) -> Result<Batch<'a>> {
+    pub fn new(
+        ctx: &Context,
+        gbuffer: &'a GBuffer,
+        gbuffer_name: &'a Path,
+        environment: &Environment,
+    ) -> Result<Batch<'a>> {
         Ok(Batch { renderer: Renderer::new(ctx, gbuffer, environment)?, gbuffer, gbuffer_name })
     }
 

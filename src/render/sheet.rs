@@ -15,7 +15,9 @@ pub struct Labeller {
 
 impl Default for Labeller {
     fn default() -> Self {
-        Labeller { font: FontRef::try_from_slice(epaint_default_fonts::UBUNTU_LIGHT).expect("the embedded font parses") }
+        Labeller {
+            font: FontRef::try_from_slice(epaint_default_fonts::UBUNTU_LIGHT).expect("the embedded font parses"),
+        }
     }
 }
 
@@ -82,11 +84,7 @@ pub fn grid(cells: &[Cell], columns: usize) -> RgbaImage {
     let rows = cells.len().div_ceil(columns.max(1));
     let cell_w = w + margin;
     let cell_h = h + caption + margin;
-    let mut sheet = RgbaImage::from_pixel(
-        columns as u32 * cell_w + margin,
-        rows as u32 * cell_h + margin,
-        PAPER,
-    );
+    let mut sheet = RgbaImage::from_pixel(columns as u32 * cell_w + margin, rows as u32 * cell_h + margin, PAPER);
     for (i, cell) in cells.iter().enumerate() {
         let (x, y) = ((i % columns) as u32 * cell_w + margin, (i / columns) as u32 * cell_h + margin);
         image::imageops::overlay(&mut sheet, &cell.image, x as i64, y as i64);
@@ -109,7 +107,15 @@ pub fn rows(rows: &[(String, Vec<(String, RgbaImage)>)]) -> RgbaImage {
         RgbaImage::from_pixel(title_width + columns * (w + margin) + margin, rows.len() as u32 * row_h + margin, PAPER);
     for (r, (title, cells)) in rows.iter().enumerate() {
         let y = r as u32 * row_h + margin;
-        labeller.draw(&mut sheet, title, margin as f32, (y + value_height + h / 2 - 9) as f32, 16.0, INK, title_width as f32);
+        labeller.draw(
+            &mut sheet,
+            title,
+            margin as f32,
+            (y + value_height + h / 2 - 9) as f32,
+            16.0,
+            INK,
+            title_width as f32,
+        );
         for (c, (value, image)) in cells.iter().enumerate() {
             let x = title_width + c as u32 * (w + margin);
             labeller.draw(&mut sheet, value, x as f32, y as f32, 13.0, FAINT_INK, w as f32);
@@ -142,7 +148,11 @@ mod tests {
 
     #[test]
     fn grids_place_every_cell() {
-        let cell = |v: u8| Cell { image: RgbaImage::from_pixel(10, 10, Rgba([v, 0, 0, 255])), title: "x".into(), caption: String::new() };
+        let cell = |v: u8| Cell {
+            image: RgbaImage::from_pixel(10, 10, Rgba([v, 0, 0, 255])),
+            title: "x".into(),
+            caption: String::new(),
+        };
         let sheet = grid(&[cell(200), cell(201), cell(202)], 2);
         let reds: std::collections::BTreeSet<u8> =
             sheet.pixels().filter(|p| p.0[1] == 0 && p.0[2] == 0).map(|p| p.0[0]).collect();
