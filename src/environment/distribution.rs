@@ -18,7 +18,8 @@ use crate::shading::common::luminance;
 use glam::Vec3;
 use std::f64::consts::PI;
 
-/// At most this many cells a side, which bounds the tables at 4097 × 4097 texels.
+/// At most this many cells a side. The tables then need images up to `MAX_CELLS + 1` texels a
+/// side; on a device whose image limit is lower, [`Distribution::for_device`] uses fewer cells.
 pub const MAX_CELLS: u32 = 4096;
 
 /// Sampling tables, laid out as `glsl/include/environment.glsl` reads them.
@@ -139,6 +140,11 @@ impl Distribution {
         Distribution::with_max_cells(env, MAX_CELLS)
     }
 
+    /// The tables for a device whose images are at most `max_image_side` texels a side.
+    pub fn for_device(env: &Environment, max_image_side: u32) -> Distribution {
+        Distribution::with_max_cells(env, MAX_CELLS.min(max_image_side.saturating_sub(1)).max(1))
+    }
+
     /// The tables with at most `max_cells` cells a side.
     pub fn with_max_cells(env: &Environment, max_cells: u32) -> Distribution {
         let (block_x, block_y) = (env.width.div_ceil(max_cells), env.height.div_ceil(max_cells));
@@ -184,11 +190,21 @@ impl Distribution {
         let solid_angles: Vec<f64> =
             (0..rows).flat_map(|r| (0..columns).map(move |c| (r, c))).map(|(r, c)| d.cell_solid_angle(r, c)).collect();
         let weights = if weights.iter().sum::<f64>() > 0.0 { weights } else { &solid_angles[..] };
-        let total: f64 = weights.iter().sum();
         let row_sums: Vec<f64> = weights.chunks(columns as usize).map(|row| row.iter().sum()).collect();
         d.conditional = weights.chunks(columns as usize).map(Table::new).collect();
         d.marginal = Table::new(&row_sums);
-        d.cell_pdf = weights.iter().zip(&solid_angles).map(|(w, omega)| (w / total / omega) as f32).collect();
+        // The pdf of exactly what the f32 tables sample: the product of the two CDF steps, not
+        // the weights they were rounded from. A cell whose steps round to nothing is never
+        // sampled and gets pdf 0, so MIS leaves it to the BRDF sample.
+        d.cell_pdf = (0..rows as usize)
+            .flat_map(|r| (0..columns as usize).map(move |c| (r, c)))
+            .map(|(r, c)| {
+                let row = d.marginal.cdf[r + 1] as f64 - d.marginal.cdf[r] as f64;
+                let table = &d.conditional[r];
+                let cell = table.cdf[c + 1] as f64 - table.cdf[c] as f64;
+                (row * cell / solid_angles[r * columns as usize + c]) as f32
+            })
+            .collect();
         d
     }
 
@@ -252,6 +268,37 @@ mod tests {
         for u in probes {
             assert_eq!(table.search(u), plain_search(&table.cdf, u), "u = {u:e}");
         }
+    }
+
+    /// The stored pdf is the density the f32 tables actually sample, cell by cell, even for a
+    /// map whose dim cells round to nothing beside a sun.
+    #[test]
+    fn stored_pdfs_are_the_sampled_probabilities() {
+        let (w, h) = (512u32, 256u32);
+        let texels = (0..w * h)
+            .map(|i| if i % w > 200 && i % w < 203 && i / w == 60 { [1e6; 3] } else { [1e-4 * (i % 97) as f32; 3] })
+            .collect();
+        let d = Distribution::build(&Environment { width: w, height: h, texels, source: "sun".into() });
+        let mut never = 0;
+        for r in 0..d.rows as usize {
+            let row = d.marginal.cdf[r + 1] as f64 - d.marginal.cdf[r] as f64;
+            for c in 0..d.columns as usize {
+                let cell = d.conditional[r].cdf[c + 1] as f64 - d.conditional[r].cdf[c] as f64;
+                let sampled = row * cell;
+                let stored = d.cell_pdf[r * d.columns as usize + c] as f64 * d.cell_solid_angle(r as u32, c as u32);
+                assert!((sampled - stored).abs() <= 1e-6 * sampled.max(1e-30), "cell {r},{c}: {sampled} vs {stored}");
+                never += (sampled == 0.0) as usize;
+            }
+        }
+        assert!(never > 0, "the test map should have cells too dim to sample");
+    }
+
+    #[test]
+    fn a_small_device_limit_shrinks_the_grid_to_fit() {
+        let env = Environment { width: 64, height: 32, texels: vec![[1.0; 3]; 64 * 32], source: "x".into() };
+        let d = Distribution::for_device(&env, 33);
+        let (width, height, _, _) = d.table_texels();
+        assert!(width <= 33 && height <= 33, "{width}x{height}");
     }
 
     #[test]

@@ -132,7 +132,8 @@ impl Renderer {
         let radiance = float_target()?;
         let display = Image::new(ctx, vk::Format::R8G8B8A8_UNORM, width, height, 1, false)?;
 
-        let gpu_environment = GpuEnvironment::upload(ctx, environment, &Distribution::build(environment))?;
+        let distribution = Distribution::for_device(environment, ctx.info().max_image_dimension_2d);
+        let gpu_environment = GpuEnvironment::upload(ctx, environment, &distribution)?;
         let environment_set = relight.bind(1, &gpu_environment.bindings())?;
         let relight_set = relight.bind(
             0,
