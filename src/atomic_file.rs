@@ -7,12 +7,16 @@ use crate::{Error, Result};
 use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The temporary name used while writing `path`: hidden, in the same folder (so the rename
-/// stays on one file system), and unique to this process.
+/// stays on one file system), and unique to this process and this write (so concurrent writers,
+/// in other processes or other threads, stay apart).
 fn temporary_path(path: &Path) -> PathBuf {
+    static WRITES: AtomicUsize = AtomicUsize::new(0);
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+    let write = WRITES.fetch_add(1, Ordering::Relaxed);
+    path.with_file_name(format!(".{name}.{}-{write}.tmp", std::process::id()))
 }
 
 /// Writes `bytes` to `path` atomically, replacing any existing file.
@@ -78,7 +82,7 @@ mod tests {
         let path = dir.path().join("gold.toml");
         std::fs::write(&path, "old").unwrap();
         // What a process killed between writing and renaming leaves behind.
-        std::fs::write(temporary_path(&path), "partial").unwrap();
+        std::fs::write(dir.path().join(format!(".gold.toml.{}-0.tmp", std::process::id() + 1)), "partial").unwrap();
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "old");
         write(&path, b"new").unwrap();
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "new");

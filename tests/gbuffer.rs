@@ -861,3 +861,34 @@ fn shaderball_keeps_the_ball_round_at_any_aspect() {
 fn shaderball_is_deterministic() {
     assert_eq!(GBuffer::shaderball(97, 61), GBuffer::shaderball(97, 61));
 }
+
+fn with_views(disc: &Disc, view: &[[f32; 3]]) -> Vec<Channel> {
+    let mut channels = disc.half_normals();
+    for (axis, name) in ["V.X", "V.Y", "V.Z"].into_iter().enumerate() {
+        channels.push(float(name, view.iter().map(|v| v[axis])));
+    }
+    channels
+}
+
+#[test]
+fn reversed_view_vectors_are_an_error_not_a_black_image() {
+    // V written as the camera ray (eye to surface) makes every covered normal face away.
+    let disc = Disc::new(10, 10);
+    let path = scratch("reversed-views.exr");
+    write_exr(&path, disc.size(), with_views(&disc, &vec![[0.0, 0.0, -1.0]; 100]), Compression::ZIP16, &[]);
+    read_err(&path, &["faces away from the view vector", "camera ray reversed"]);
+}
+
+#[test]
+fn a_few_normals_facing_away_shade_black_with_a_warning() {
+    let disc = Disc::new(10, 10);
+    let mut view = vec![[0.0, 0.0, 1.0]; 100];
+    let covered: Vec<usize> = (0..100).filter(|&i| disc.covered(i)).collect();
+    view[covered[0]] = [0.0, 0.0, -1.0];
+    view[covered[1]] = [0.0, 0.0, -1.0];
+    let path = scratch("few-away.exr");
+    write_exr(&path, disc.size(), with_views(&disc, &view), Compression::ZIP16, &[]);
+    let (_, warnings) = read_ok(&path);
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(warnings[0].contains("at 2 pixels of") && warnings[0].contains("shade black"), "{}", warnings[0]);
+}

@@ -264,7 +264,7 @@ fn unset_values_take_their_defaults() {
     assert_eq!(look.file.as_deref(), Some(Path::new(SHOT)));
     assert_eq!(look.environment, Default::default());
     assert_eq!(look.render, Default::default());
-    assert!(look.objects.is_empty() && look.mask_names().is_empty());
+    assert!(look.objects.is_empty());
 
     let look =
         Look::parse("[[object]]\n[[object.layer]]\n\n[[object.layer]]\npreset = \"gold\"\n", Path::new(SHOT)).unwrap();
@@ -416,8 +416,8 @@ fn set_everywhere_overrides_every_layer_and_is_written_back() {
     let text = "[[object]]\n[[object.layer]]\npreset = \"gold\"\n[[object]]\nid = 1\n[[object.layer]]\n\
                 [[object.layer]]\npreset = \"grime\"\n[object.layer.set]\nmetallic = 1\n";
     let mut look = Look::parse(text, Path::new(SHOT)).unwrap();
-    look.set_everywhere(Param::Roughness, Value::Scalar(0.33));
-    look.set_everywhere(Param::BaseColor, Value::Color([0.2, 0.3, 0.4]));
+    look.set_everywhere(Param::Roughness, Value::Scalar(0.33)).unwrap();
+    look.set_everywhere(Param::BaseColor, Value::Color([0.2, 0.3, 0.4])).unwrap();
     for layer in look.objects.iter().flat_map(|o| &o.layers) {
         assert_eq!(layer.params.roughness, 0.33);
         assert_eq!(layer.params.base_color, [0.2, 0.3, 0.4]);
@@ -426,9 +426,10 @@ fn set_everywhere_overrides_every_layer_and_is_written_back() {
     assert_eq!(look.objects[1].layers[1].overrides, vec![Param::BaseColor, Param::Metallic, Param::Roughness]);
     assert_eq!(Look::parse(&look.to_toml(), Path::new(SHOT)).unwrap(), look);
 
-    // A value that fails the range check changes nothing.
+    // A value that fails the range check changes nothing and says why.
     let before = look.clone();
-    look.set_everywhere(Param::Roughness, Value::Scalar(7.0));
+    let error = look.set_everywhere(Param::Roughness, Value::Scalar(7.0)).unwrap_err();
+    assert!(error.contains("roughness"), "{error}");
     assert_eq!(look, before);
 }
 
@@ -448,20 +449,11 @@ fn stacks_are_found_by_id_then_default() {
 }
 
 #[test]
-fn mask_names_are_sorted_and_unique() {
-    let text = "[[object]]\n[[object.layer]]\nmask = \"zebra\"\n[[object.layer]]\nmask = \"dust\"\n\
-                [[object]]\nid = 4\n[[object.layer]]\n[[object.layer]]\nmask = \"dust\"\n[[object.layer]]\nmask = \"chips\"\n";
-    let look = Look::parse(text, Path::new(SHOT)).unwrap();
-    assert_eq!(look.mask_names(), ["chips", "dust", "zebra"]);
-}
-
-#[test]
 fn the_builtin_default_look_shows_layering_on_the_shader_ball() {
     let look = Look::builtin_default();
     assert_eq!(look.file, None);
     assert_eq!(look.render.spp, Some(256));
     assert_eq!(look.environment.rotation, Some(-90.0));
-    assert_eq!(look.mask_names(), ["gradient", "grunge", "stripes"]);
     let ids: Vec<Option<u32>> = look.objects.iter().map(|o| o.id).collect();
     assert_eq!(ids, [None, Some(1), Some(2)]);
 

@@ -194,7 +194,7 @@ fn gpu_relight_matches_the_cpu_mirror() {
     common::gpu::finish(ctx);
 }
 
-/// display.comp applies exposure, each tone map and the sRGB OETF exactly as the Rust mirror.
+/// finalize.comp applies exposure, each tone map and the sRGB OETF exactly as the Rust mirror.
 #[test]
 fn gpu_display_matches_the_rust_tonemaps() {
     let ctx = common::gpu::context();

@@ -1,7 +1,7 @@
 //! The committed SPIR-V in `spirv/` is what `glsl/` compiles to, and it validates.
 //!
-//! Both checks need the Khronos tools (Debian: glslang-tools, spirv-tools) and are skipped, with
-//! a note, where they are missing; CI installs them. To regenerate the SPIR-V after editing a
+//! Both checks need the Khronos tools (Debian: glslang-tools, spirv-tools). They are skipped, with
+//! a note, where the tools are missing, except in CI (`CI` set), where that fails. To regenerate the SPIR-V after editing a
 //! kernel: `LOOKDEV_BLESS_SPIRV=1 cargo test --release --test spirv`.
 
 use std::path::{Path, PathBuf};
@@ -21,8 +21,12 @@ fn kernels() -> Vec<PathBuf> {
     files
 }
 
+/// Whether a tool is installed. In CI (`CI` set) a missing tool is a failure, not a skip: the
+/// checks it makes are part of what CI vouches for.
 fn tool(name: &str) -> bool {
-    Command::new(name).arg("--version").output().is_ok()
+    let found = Command::new(name).arg("--version").output().is_ok();
+    assert!(found || std::env::var_os("CI").is_none(), "{name} is not installed, and CI needs it");
+    found
 }
 
 fn spirv_path(kernel: &Path) -> PathBuf {
@@ -40,12 +44,7 @@ fn every_kernel_is_registered_and_committed() {
         assert!(names.iter().any(|n| n == name), "gpu::shaders::ALL lists {name}, but glsl/{name}.comp is missing");
     }
     for kernel in kernels() {
-        let bytes = std::fs::read(spirv_path(&kernel)).expect("compiled SPIR-V is committed");
-        let embedded = lookdev::gpu::shaders::ALL
-            .iter()
-            .find(|k| k.name == kernel.file_stem().unwrap().to_string_lossy())
-            .unwrap();
-        assert_eq!(bytes, embedded.spirv, "the binary embeds stale SPIR-V for {}", kernel.display());
+        assert!(spirv_path(&kernel).is_file(), "{} has no committed SPIR-V", kernel.display());
     }
 }
 

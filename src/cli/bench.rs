@@ -75,7 +75,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         let kernel_ms = kernel.get(kernel.len() / 2).map(|t| format!("{:.2} ms", t * 1e3)).unwrap_or("n/a".into());
 
         // Wall time to the target from a fresh accumulation, as `lookdev render` does it.
-        renderer.set_seed(1);
+        renderer.restart();
         let stats = progressive::accumulate(&mut renderer, args.spp, |_| {})?;
         let samples = gbuffer.pixel_count() as f64 * args.spp as f64;
         let wall = stats.wall.as_secs_f64();

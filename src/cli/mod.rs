@@ -2,6 +2,7 @@
 
 mod bench;
 mod gbuffer;
+mod inputs;
 mod lint;
 mod presets;
 mod progress;
@@ -46,7 +47,14 @@ pub enum Command {
 pub fn run(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<()> {
     let cli = match Cli::try_parse_from(args) {
         Ok(cli) => cli,
-        Err(e) if matches!(e.kind(), clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion) => {
+        Err(e)
+            if matches!(
+                e.kind(),
+                clap::error::ErrorKind::DisplayHelp
+                    | clap::error::ErrorKind::DisplayVersion
+                    | clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+            ) =>
+        {
             e.exit()
         }
         Err(e) => {
@@ -69,7 +77,7 @@ pub fn run(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<()> {
 }
 
 fn list_devices() -> Result<()> {
-    for (name, kind) in crate::gpu::context::list_devices(&ContextOptions::from_env(None))? {
+    for (name, kind) in crate::gpu::context::list_devices()? {
         println!("{name} ({kind})");
     }
     Ok(())

@@ -1,14 +1,15 @@
 //! `lookdev presets list | show | save | sheet`: the preset library.
 
+use super::inputs::{self, DisplayArgs, LightingArgs, SamplingArgs};
 use super::progress::Progress;
-use crate::environment::{self, Environment, LoadOptions};
+use crate::environment::{self, Environment};
 use crate::gbuffer::GBuffer;
 use crate::material::library::{self, Library, Origin};
 use crate::material::look::{Layer, Look, ObjectStack};
 use crate::material::params::{Param, Params};
 use crate::material::Preset;
 use crate::render::batch::Batch;
-use crate::render::settings::{Overrides, Settings};
+use crate::render::settings::Settings;
 use crate::render::sheet::{self, Cell};
 use crate::{atomic_file, Error, Result};
 use clap::{Args, Subcommand};
@@ -69,10 +70,10 @@ pub struct SheetArgs {
     /// Only presets with this tag.
     #[arg(long)]
     pub tag: Option<String>,
-    #[arg(long, value_name = "FILE.exr|.hdr")]
-    pub env: Option<PathBuf>,
-    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
-    pub rotation: Option<f32>,
+    #[command(flatten)]
+    pub lighting: LightingArgs,
+    #[command(flatten)]
+    pub display: DisplayArgs,
     #[arg(long, default_value_t = 128)]
     pub spp: u32,
     /// Side of each render in pixels.
@@ -133,9 +134,10 @@ fn list(tag: Option<&str>) -> Result<()> {
 fn show(name: &str) -> Result<()> {
     let library = Library::standard();
     let preset = library.resolve(name).map_err(Error::input)?;
-    let origin = match library.find(name) {
-        Some(path) => path.display().to_string(),
-        None => "built-in".to_string(),
+    let origin = if library::looks_like_path(name) {
+        name.to_string()
+    } else {
+        library.find(name).map(|path| path.display().to_string()).unwrap_or_else(|| "built-in".to_string())
     };
     println!("name = {}", preset.name);
     println!("source = {origin}");
@@ -247,13 +249,17 @@ fn sheet(args: SheetArgs) -> Result<()> {
         return Err(Error::input(format!("--size {}: renders must be 16 to 2048 pixels", args.size)));
     }
     let presets = presets_with_tag(args.tag.as_deref())?;
-    let environment = match &args.env {
-        Some(path) => environment::load::load(path, &LoadOptions::default())?,
+    // The default look's light, unless another environment is given.
+    let mut base = Look::builtin_default();
+    if args.lighting.env.is_some() {
+        base.environment = Default::default();
+    }
+    let sampling = SamplingArgs { spp: Some(args.spp), seed: None };
+    let settings = Settings::resolve(&base, &inputs::overrides(&args.lighting, &sampling, &args.display))?;
+    let environment = match &settings.environment {
+        Some(path) => environment::load::load(path, &args.lighting.load_options())?,
         None => Environment::studio(),
     };
-    let base = Look::builtin_default();
-    let overrides = Overrides { rotation: args.rotation, spp: Some(args.spp), ..Overrides::default() };
-    let settings = Settings::resolve(&base, &overrides)?;
     let gbuffer = GBuffer::shaderball(args.size, args.size);
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();

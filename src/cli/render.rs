@@ -1,12 +1,10 @@
 //! `lookdev render`.
 
+use super::inputs::{self, DisplayArgs, LightingArgs, SamplingArgs};
 use super::progress::Progress;
-use crate::environment::LoadOptions;
 use crate::render::output::{self, OutputFormat};
 use crate::render::progressive;
 use crate::render::scene::Scene;
-use crate::render::settings::Overrides;
-use crate::render::tonemap::Tonemap;
 use crate::render::Renderer;
 use crate::{Error, Result};
 use clap::Args;
@@ -17,54 +15,27 @@ pub struct RenderArgs {
     /// The g-buffer EXR to relight (default: the built-in shader ball, 1024x1024).
     #[arg(long, value_name = "FILE.exr")]
     pub gbuffer: Option<PathBuf>,
-    /// Equirectangular environment (default: the look's, else the embedded studio).
-    #[arg(long, value_name = "FILE.exr|.hdr")]
-    pub env: Option<PathBuf>,
-    /// Environment rotation about +Y, in degrees.
-    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
-    pub rotation: Option<f32>,
-    /// Environment radiance scale.
-    #[arg(long, value_name = "X")]
-    pub intensity: Option<f32>,
     /// The look: layer stacks, environment and render settings.
     #[arg(long, value_name = "FILE.toml")]
     pub look: Option<PathBuf>,
     /// Override a parameter on every layer of every object, e.g. --set metallic=1.
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
-    /// Samples per pixel (each one environment and one BRDF sample).
-    #[arg(long, value_name = "N")]
-    pub spp: Option<u32>,
-    #[arg(long, value_name = "N")]
-    pub seed: Option<u32>,
-    /// Exposure in stops, for PNG output.
-    #[arg(long, value_name = "EV", allow_hyphen_values = true)]
-    pub exposure: Option<f32>,
-    /// PNG tone map: linear, neutral (Khronos PBR Neutral), aces or agx.
-    #[arg(long, value_name = "NAME", value_parser = parse_tonemap)]
-    pub tonemap: Option<Tonemap>,
-    /// Show black (EXR: transparent) instead of the environment behind the objects.
-    #[arg(long)]
-    pub no_background: bool,
+    #[command(flatten)]
+    pub lighting: LightingArgs,
+    #[command(flatten)]
+    pub sampling: SamplingArgs,
+    #[command(flatten)]
+    pub display: DisplayArgs,
     /// Vulkan device to use: part of its name (lavapipe is "llvmpipe").
     #[arg(long, value_name = "NAME")]
     pub device: Option<String>,
-    /// Read an environment that is not 2:1 as equirectangular anyway.
-    #[arg(long)]
-    pub env_any_aspect: bool,
-    /// Replace NaN, infinite and negative environment texels instead of refusing the file.
-    #[arg(long)]
-    pub env_clamp: bool,
     /// No progress bar or summary.
     #[arg(long, short)]
     pub quiet: bool,
     /// Output image: .png (exposure, tone map, sRGB) or .exr (linear radiance).
     #[arg(long, value_name = "FILE.png|FILE.exr")]
     pub out: PathBuf,
-}
-
-fn parse_tonemap(name: &str) -> std::result::Result<Tonemap, String> {
-    Tonemap::from_name(name).ok_or_else(|| format!("unknown tone map '{name}' (expected linear, neutral, aces, agx)"))
 }
 
 pub fn run(args: RenderArgs) -> Result<()> {
@@ -74,25 +45,14 @@ pub fn run(args: RenderArgs) -> Result<()> {
             return Err(Error::input_file(&args.out, "the output folder does not exist"));
         }
     }
-    let overrides = Overrides {
-        environment: args.env.clone(),
-        rotation: args.rotation,
-        intensity: args.intensity,
-        no_background: args.no_background,
-        spp: args.spp,
-        seed: args.seed,
-        exposure: args.exposure,
-        tonemap: args.tonemap,
-    };
-    let env_options = LoadOptions { any_aspect: args.env_any_aspect, clamp_invalid: args.env_clamp };
-    let mut sets = Vec::new();
-    for text in &args.set {
-        sets.push(super::parse_set(text)?);
-    }
-    let scene = Scene::load(args.gbuffer.as_deref(), args.look.as_deref(), &sets, &overrides, &env_options)?;
+    let overrides = inputs::overrides(&args.lighting, &args.sampling, &args.display);
+    let sets = inputs::parse_sets(&args.set)?;
+    let scene =
+        Scene::load(args.gbuffer.as_deref(), args.look.as_deref(), &sets, &overrides, &args.lighting.load_options())?;
 
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
+    scene.check_device(ctx.info())?;
     let device_name = ctx.info().name.clone();
     let settings = &scene.settings;
     let stats = {

@@ -2,14 +2,14 @@
 //!
 //! Frames are numbered from 1; frame f of N turns the environment by (f − 1)·360°/N on top of
 //! the look's rotation. Every frame is rendered from scratch with the same seed, so frames from
-//! different machines (and any `--range` split) match a single run bit for bit.
+//! different machines with the same device and driver (and any `--range` split) match a single
+//! run bit for bit.
 
+use super::inputs::{self, DisplayArgs, LightingArgs, SamplingArgs};
 use super::progress::Progress;
-use crate::environment::LoadOptions;
 use crate::render::batch::Batch;
 use crate::render::output::{self, OutputFormat};
 use crate::render::scene::Scene;
-use crate::render::settings::Overrides;
 use crate::{Error, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -20,10 +20,15 @@ pub struct TurntableArgs {
     pub look: Option<PathBuf>,
     #[arg(long, value_name = "FILE.exr")]
     pub gbuffer: Option<PathBuf>,
-    #[arg(long, value_name = "FILE.exr|.hdr")]
-    pub env: Option<PathBuf>,
-    #[arg(long)]
-    pub spp: Option<u32>,
+    /// Override a parameter on every layer of every object, e.g. --set metallic=1.
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+    #[command(flatten)]
+    pub lighting: LightingArgs,
+    #[command(flatten)]
+    pub sampling: SamplingArgs,
+    #[command(flatten)]
+    pub display: DisplayArgs,
     /// Frames in the full turn.
     #[arg(long)]
     pub frames: u32,
@@ -91,10 +96,13 @@ pub fn run(args: TurntableArgs) -> Result<()> {
     if let Some(dir) = pattern.path(1).parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, format!("cannot create the output folder: {e}")))?;
     }
-    let overrides = Overrides { environment: args.env.clone(), spp: args.spp, ..Overrides::default() };
-    let scene = Scene::load(args.gbuffer.as_deref(), args.look.as_deref(), &[], &overrides, &LoadOptions::default())?;
+    let overrides = inputs::overrides(&args.lighting, &args.sampling, &args.display);
+    let sets = inputs::parse_sets(&args.set)?;
+    let scene =
+        Scene::load(args.gbuffer.as_deref(), args.look.as_deref(), &sets, &overrides, &args.lighting.load_options())?;
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
+    scene.check_device(ctx.info())?;
     {
         let mut batch = Batch::new(&ctx, &scene.gbuffer, Path::new(&scene.gbuffer_name), &scene.environment)?;
         let (width, height) = (batch.width(), batch.height());

@@ -1,13 +1,14 @@
 //! `lookdev wedge`: a look rendered once per value of a parameter, in labelled rows; with
 //! `--param all`, one row per parameter, as in figure 16 of Burley's 2012 notes.
 
+use super::inputs::{self, DisplayArgs, LightingArgs, SamplingArgs};
 use super::progress::Progress;
-use crate::environment::{self, Environment, LoadOptions};
+use crate::environment::{self, Environment};
 use crate::gbuffer::GBuffer;
 use crate::material::params::{check, Param, Value};
 use crate::material::Look;
 use crate::render::batch::Batch;
-use crate::render::settings::{Overrides, Settings};
+use crate::render::settings::Settings;
 use crate::render::sheet;
 use crate::{Error, Result};
 use clap::Args;
@@ -25,8 +26,10 @@ pub struct WedgeArgs {
     /// lit as the built-in default look).
     #[arg(long, value_name = "FILE.toml")]
     pub look: Option<PathBuf>,
-    #[arg(long, value_name = "FILE.exr|.hdr")]
-    pub env: Option<PathBuf>,
+    #[command(flatten)]
+    pub lighting: LightingArgs,
+    #[command(flatten)]
+    pub display: DisplayArgs,
     #[arg(long, default_value_t = 64)]
     pub spp: u32,
     /// Side of each render in pixels.
@@ -90,11 +93,14 @@ pub fn run(args: WedgeArgs) -> Result<()> {
     }
     let look = match &args.look {
         Some(path) => Look::load(path)?,
+        // The default look's light, unless another environment is given.
+        None if args.lighting.env.is_some() => Look { environment: Default::default(), ..default_look() },
         None => default_look(),
     };
-    let settings = Settings::resolve(&look, &Overrides { spp: Some(args.spp), ..Overrides::default() })?;
-    let environment = match args.env.as_ref().or(settings.environment.as_ref()) {
-        Some(path) => environment::load::load(path, &LoadOptions::default())?,
+    let sampling = SamplingArgs { spp: Some(args.spp), seed: None };
+    let settings = Settings::resolve(&look, &inputs::overrides(&args.lighting, &sampling, &args.display))?;
+    let environment = match &settings.environment {
+        Some(path) => environment::load::load(path, &args.lighting.load_options())?,
         None => Environment::studio(),
     };
     let gbuffer = GBuffer::shaderball(args.size, args.size);
@@ -112,7 +118,7 @@ pub fn run(args: WedgeArgs) -> Result<()> {
                 let off =
                     row_look.objects.iter().flat_map(|o| &o.layers).all(|l| l.params.get(other) == Value::Scalar(0.0));
                 if off {
-                    row_look.set_everywhere(other, Value::Scalar(1.0));
+                    row_look.set_everywhere(other, Value::Scalar(1.0)).map_err(Error::input)?;
                     title = format!("{title} ({other} 1)");
                 }
             }
@@ -120,7 +126,7 @@ pub fn run(args: WedgeArgs) -> Result<()> {
             for &v in &values {
                 let mut variant = row_look.clone();
                 let value = if param.is_color() { Value::Color([v; 3]) } else { Value::Scalar(v) };
-                variant.set_everywhere(param, value);
+                variant.set_everywhere(param, value).map_err(Error::input)?;
                 batch.render(&variant, &settings, |_| {})?;
                 let pixels = batch.display(&settings)?;
                 let image = image::RgbaImage::from_raw(args.size, args.size, pixels).expect("size matches");

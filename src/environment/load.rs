@@ -52,13 +52,29 @@ pub fn read_exr_texels(bytes: &[u8], name: &str) -> Result<(u32, u32, Vec<[f32; 
     let layer = &image.layer_data;
     let (width, height) = (layer.size.width(), layer.size.height());
     let channels = &layer.channel_data.list;
-    let find = |wanted: &str| {
-        channels.iter().find(|c| {
-            let n = c.name.to_string();
-            n == wanted || n.ends_with(&format!(".{wanted}"))
-        })
+    // A channel named exactly `R`, else the only one ending in `.R` (one layer of a multi-layer
+    // file); several candidates are ambiguous and refused.
+    let mut ambiguous = None;
+    let mut find = |wanted: &str| {
+        if let Some(exact) = channels.iter().find(|c| c.name.to_string() == wanted) {
+            return Some(exact);
+        }
+        let suffixed: Vec<_> =
+            channels.iter().filter(|c| c.name.to_string().ends_with(&format!(".{wanted}"))).collect();
+        if suffixed.len() > 1 {
+            ambiguous = Some(suffixed.iter().map(|c| c.name.to_string()).collect::<Vec<_>>().join(", "));
+        }
+        (suffixed.len() == 1).then(|| suffixed[0])
     };
-    let planes: Vec<Vec<f32>> = match (find("R"), find("G"), find("B"), find("Y")) {
+    let (r, g, b, y) = (find("R"), find("G"), find("B"), find("Y"));
+    if let Some(names) = ambiguous {
+        return Err(Error::input_file(name, format!("several layers could be the radiance ({names}); keep one")));
+    }
+    let expected = width * height;
+    if let Some(short) = channels.iter().find(|c| c.sample_data.len() != expected) {
+        return Err(Error::input_file(name, format!("channel {} has the wrong number of samples", short.name)));
+    }
+    let planes: Vec<Vec<f32>> = match (r, g, b, y) {
         (Some(r), Some(g), Some(b), _) => [r, g, b].iter().map(|c| c.sample_data.values_as_f32().collect()).collect(),
         (_, _, _, Some(y)) => {
             let grey: Vec<f32> = y.sample_data.values_as_f32().collect();

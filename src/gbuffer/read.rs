@@ -21,7 +21,7 @@ impl GBuffer {
     }
 
     /// Like [`GBuffer::read`], but returns the warnings (one line each, naming the file) instead
-    /// of printing them, for callers that show them elsewhere, such as the viewer.
+    /// of printing them, for callers that show them elsewhere.
     pub fn read_with_warnings(path: &Path) -> Result<(GBuffer, Vec<String>)> {
         let raw = read_exr(path)?;
         validate::build(path, raw)

@@ -68,6 +68,7 @@ impl Checker<'_> {
             Some(raw_view) => self.views(raw_view)?,
             None => vec![Vec3::from(DEFAULT_VIEW); normal.len()],
         };
+        self.facing(&normal, &view, &coverage)?;
         let tangent = match &raw_tangent {
             Some(raw_tangent) => self.tangents(&normal, raw_tangent, &coverage),
             None => normal.iter().map(|n| stable_tangent(n.to_array())).collect(),
@@ -259,6 +260,38 @@ impl Checker<'_> {
             )));
         }
         Ok(views)
+    }
+
+    /// Covered pixels whose normal faces away from their view vector shade black (the BRDF is
+    /// zero there). A few are normal (bump and normal maps produce them) and get a warning; most
+    /// of the image facing away means V points from the eye to the surface instead of from the
+    /// surface to the eye, which is an error rather than a silently black render.
+    fn facing(&mut self, normals: &[Vec3], views: &[Vec3], coverage: &[f32]) -> Result<()> {
+        let mut away = Offenders::default();
+        let mut covered = 0usize;
+        for (i, ((n, v), &a)) in normals.iter().zip(views).zip(coverage).enumerate() {
+            if a > 0.0 {
+                covered += 1;
+                if n.dot(*v) <= 0.0 {
+                    away.add(i);
+                }
+            }
+        }
+        if away.count == 0 {
+            return Ok(());
+        }
+        let summary = format!(
+            "the normal faces away from the view vector V at {} of {covered} covered pixels ({})",
+            counted(away.count, "pixel"),
+            away.first_at(self.width)
+        );
+        if away.count * 2 > covered {
+            return Err(self.error(format!(
+                "{summary}: V must point from the surface toward the eye; is it the camera ray reversed?"
+            )));
+        }
+        self.warn(format!("{summary}; they shade black"));
+        Ok(())
     }
 
     /// Stored tangents made orthogonal to N; degenerate ones take the stable frame. Only covered

@@ -1,7 +1,6 @@
 //! Writing a g-buffer file, in the format that `read` accepts.
 
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::path::Path;
 
 use exr::prelude::{
     AnyChannel, AnyChannels, AttributeValue, Blocks, Compression, Encoding, FlatSamples, Image, Layer, LayerAttributes,
@@ -25,19 +24,12 @@ impl GBuffer {
     pub fn write(&self, path: &Path) -> Result<()> {
         self.check_lengths(path)?;
         let image = Image::from_layer(self.to_layer());
-        let temp = temp_path(path)?;
-        let result = image
-            .write()
-            .to_file(&temp)
-            .map_err(|e| Error::io(path, format!("cannot write the g-buffer ({e})")))
-            .and_then(|()| {
-                std::fs::rename(&temp, path).map_err(|e| Error::io(path, format!("cannot replace the file ({e})")))
-            });
-        if result.is_err() {
-            // Best effort: the error that matters is the one being returned.
-            let _ = std::fs::remove_file(&temp);
-        }
-        result
+        crate::atomic_file::write_with(path, true, |file| {
+            image
+                .write()
+                .to_buffered(std::io::BufWriter::new(file))
+                .map_err(|e| std::io::Error::other(format!("cannot encode the g-buffer ({e})")))
+        })
     }
 
     /// The fields are public, so make sure they agree before the encoder indexes them.
@@ -110,16 +102,4 @@ fn half_channel(name: &str, values: &[f32]) -> AnyChannel<FlatSamples> {
 /// own conversion panics on characters outside Latin-1.
 fn text(string: &str) -> Text {
     Text::from_slice_unchecked(string.as_bytes())
-}
-
-/// A hidden temporary file beside `path`, so the final rename stays on one file system. The
-/// process ID and a counter keep concurrent writers (other processes, other threads) apart.
-fn temp_path(path: &Path) -> Result<PathBuf> {
-    static COUNTER: AtomicUsize = AtomicUsize::new(0);
-    let Some(file_name) = path.file_name() else {
-        return Err(Error::io(path, "not a file name to write to"));
-    };
-    let unique = COUNTER.fetch_add(1, Ordering::Relaxed);
-    let temp_name = format!(".{}.{}-{unique}.tmp", file_name.to_string_lossy(), std::process::id());
-    Ok(path.with_file_name(temp_name))
 }

@@ -31,10 +31,8 @@ impl ContextOptions {
 pub struct DeviceInfo {
     pub name: String,
     pub device_type: vk::PhysicalDeviceType,
-    pub api_version: u32,
     /// Nanoseconds per timestamp tick, or None when the queue cannot write timestamps.
     pub timestamp_period_ns: Option<f64>,
-    pub max_storage_buffer_range: u64,
     pub max_image_dimension_2d: u32,
     pub max_image_array_layers: u32,
     pub subgroup_size: u32,
@@ -65,7 +63,10 @@ pub struct Shared {
     pub memory_properties: vk::PhysicalDeviceMemoryProperties,
     pub info: DeviceInfo,
     command_pool: vk::CommandPool,
-    // Boxed so its address, handed to the debug callback, stays fixed.
+    /// Serialises [`Context::run`]: the command pool and the queue must not be used from two
+    /// threads at once.
+    submission: std::sync::Mutex<()>,
+    /// Kept alive for as long as the debug messenger that points at it.
     _counter: Arc<ValidationCounter>,
 }
 
@@ -138,10 +139,7 @@ impl Context {
             .map_err(|e| Error::gpu(format!("no Vulkan loader found ({e}); {INSTALL_DRIVER}")))?;
         let counter = Arc::new(ValidationCounter::default());
         let (instance, debug) = create_instance(&entry, options.validation, &counter)?;
-        let shared = match pick_and_create_device(entry, instance, debug, options, counter.clone()) {
-            Ok(shared) => shared,
-            Err(e) => return Err(e),
-        };
+        let shared = pick_and_create_device(entry, instance, debug, options, counter.clone())?;
         Ok(Context { shared: Arc::new(shared), counter })
     }
 
@@ -160,10 +158,12 @@ impl Context {
         &self.shared.info
     }
 
-    /// Records commands with `record`, submits them and waits. A full memory barrier before and
-    /// after makes every submission see the results of the previous one.
+    /// Records commands with `record`, submits them and waits. A full memory barrier before
+    /// makes the submission see everything earlier ones wrote; one after makes its writes
+    /// visible to the host, for read-backs.
     pub fn run<T>(&self, record: impl FnOnce(vk::CommandBuffer) -> Result<T>) -> Result<T> {
         let device = &self.device;
+        let _serialised = self.submission.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
         unsafe {
             let alloc = vk::CommandBufferAllocateInfo::default()
                 .command_pool(self.command_pool)
@@ -178,7 +178,7 @@ impl Context {
                 )?;
                 full_barrier(device, cmd);
                 let value = record(cmd)?;
-                full_barrier(device, cmd);
+                host_barrier(device, cmd);
                 device.end_command_buffer(cmd)?;
                 let cmds = [cmd];
                 let submit = vk::SubmitInfo::default().command_buffers(&cmds);
@@ -203,6 +203,24 @@ pub fn full_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
             cmd,
             vk::PipelineStageFlags::ALL_COMMANDS,
             vk::PipelineStageFlags::ALL_COMMANDS,
+            vk::DependencyFlags::empty(),
+            &[barrier],
+            &[],
+            &[],
+        );
+    }
+}
+
+/// Makes everything written so far visible to host reads once the submission completes.
+fn host_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
+    let barrier = vk::MemoryBarrier::default()
+        .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
+        .dst_access_mask(vk::AccessFlags::HOST_READ);
+    unsafe {
+        device.cmd_pipeline_barrier(
+            cmd,
+            vk::PipelineStageFlags::ALL_COMMANDS,
+            vk::PipelineStageFlags::HOST,
             vk::DependencyFlags::empty(),
             &[barrier],
             &[],
@@ -310,7 +328,14 @@ fn pick_and_create_device(
     let pool_info = vk::CommandPoolCreateInfo::default()
         .queue_family_index(queue_family)
         .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
-    let command_pool = unsafe { device.create_command_pool(&pool_info, None) }?;
+    let command_pool = match unsafe { device.create_command_pool(&pool_info, None) } {
+        Ok(pool) => pool,
+        Err(e) => {
+            unsafe { device.destroy_device(None) };
+            destroy_instance(&instance, &debug);
+            return Err(e.into());
+        }
+    };
     Ok(Shared {
         _entry: entry,
         instance,
@@ -322,14 +347,13 @@ fn pick_and_create_device(
         memory_properties,
         info,
         command_pool,
+        submission: std::sync::Mutex::new(()),
         _counter: counter,
     })
 }
 
-fn choose_physical_device(
-    instance: &ash::Instance,
-    options: &ContextOptions,
-) -> Result<(vk::PhysicalDevice, u32, DeviceInfo)> {
+/// The devices lookdev can use (Vulkan 1.3 with a compute queue), best first.
+fn candidates(instance: &ash::Instance) -> Result<Vec<(vk::PhysicalDevice, u32, DeviceInfo)>> {
     let devices = unsafe { instance.enumerate_physical_devices() }?;
     let mut candidates = Vec::new();
     for pd in devices {
@@ -349,15 +373,22 @@ fn choose_physical_device(
         let info = DeviceInfo {
             name: device_name(&props),
             device_type: props.device_type,
-            api_version: props.api_version,
             timestamp_period_ns: timestamps.then_some(props.limits.timestamp_period as f64),
-            max_storage_buffer_range: props.limits.max_storage_buffer_range as u64,
             max_image_dimension_2d: props.limits.max_image_dimension2_d,
             max_image_array_layers: props.limits.max_image_array_layers,
             subgroup_size: subgroup.subgroup_size,
         };
         candidates.push((pd, family as u32, info));
     }
+    candidates.sort_by_key(|c| rank(c.2.device_type));
+    Ok(candidates)
+}
+
+fn choose_physical_device(
+    instance: &ash::Instance,
+    options: &ContextOptions,
+) -> Result<(vk::PhysicalDevice, u32, DeviceInfo)> {
+    let mut candidates = candidates(instance)?;
     if candidates.is_empty() {
         return Err(Error::gpu(format!("no Vulkan 1.3 device with a compute queue was found; {INSTALL_DRIVER}")));
     }
@@ -368,22 +399,24 @@ fn choose_physical_device(
             Error::input(format!("--device {wanted}: no such device (available: {})", names.join(", ")))
         });
     }
-    candidates.sort_by_key(|c| rank(c.2.device_type));
     Ok(candidates.remove(0))
 }
 
-/// The names and kinds of the usable devices, best first (for `lookdev devices`).
-pub fn list_devices(options: &ContextOptions) -> Result<Vec<(String, String)>> {
-    let ctx = Context::new(options)?;
-    let devices = unsafe { ctx.instance.enumerate_physical_devices() }?;
-    let mut out: Vec<(u32, String, String)> = devices
+/// The names and kinds of the devices lookdev can use, best first (for `lookdev devices`).
+pub fn list_devices() -> Result<Vec<(String, String)>> {
+    let entry = unsafe { ash::Entry::load() }
+        .map_err(|e| Error::gpu(format!("no Vulkan loader found ({e}); {INSTALL_DRIVER}")))?;
+    let counter = Arc::new(ValidationCounter::default());
+    let (instance, debug) = create_instance(&entry, false, &counter)?;
+    let candidates = candidates(&instance);
+    unsafe {
+        if let Some((loader, messenger)) = debug {
+            loader.destroy_debug_utils_messenger(messenger, None);
+        }
+        instance.destroy_instance(None);
+    }
+    Ok(candidates?
         .into_iter()
-        .map(|pd| {
-            let props = unsafe { ctx.instance.get_physical_device_properties(pd) };
-            let kind = format!("{:?}", props.device_type).to_lowercase().replace('_', " ");
-            (rank(props.device_type), device_name(&props), kind)
-        })
-        .collect();
-    out.sort_by_key(|d| d.0);
-    Ok(out.into_iter().map(|(_, name, kind)| (name, kind)).collect())
+        .map(|(_, _, info)| (info.name, format!("{:?}", info.device_type).to_lowercase().replace('_', " ")))
+        .collect())
 }

@@ -69,26 +69,21 @@ impl Buffer {
     }
 
     fn new(ctx: &Context, size: u64, usage: vk::BufferUsageFlags, host_visible: bool) -> Result<Buffer> {
-        let shared = ctx.shared.clone();
         let size = size.max(16);
         let info = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
-        let device = &shared.device;
-        let buffer = unsafe { device.create_buffer(&info, None) }?;
+        let buffer = unsafe { ctx.device.create_buffer(&info, None) }?;
+        // From here on, Drop releases whatever has been created if a later step fails.
+        let mut result =
+            Buffer { shared: ctx.shared.clone(), buffer, memory: vk::DeviceMemory::null(), size, mapped: None };
+        let device = &result.shared.device;
         let requirements = unsafe { device.get_buffer_memory_requirements(buffer) };
-        let memory = match allocate(&shared, requirements, host_visible) {
-            Ok(m) => m,
-            Err(e) => {
-                unsafe { device.destroy_buffer(buffer, None) };
-                return Err(e);
-            }
-        };
-        unsafe { device.bind_buffer_memory(buffer, memory, 0) }?;
-        let mapped = if host_visible {
-            Some(unsafe { device.map_memory(memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }? as *mut u8)
-        } else {
-            None
-        };
-        Ok(Buffer { shared, buffer, memory, size, mapped })
+        result.memory = allocate(&result.shared, requirements, host_visible)?;
+        unsafe { device.bind_buffer_memory(buffer, result.memory, 0) }?;
+        if host_visible {
+            let pointer = unsafe { device.map_memory(result.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }?;
+            result.mapped = Some(pointer as *mut u8);
+        }
+        Ok(result)
     }
 
     /// The mapped bytes of a staging buffer.
@@ -169,8 +164,6 @@ impl Image {
                 "a {width}x{height} image is outside what this device supports (1 to {max} pixels a side)"
             )));
         }
-        let shared = ctx.shared.clone();
-        let device = &shared.device;
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
@@ -182,24 +175,29 @@ impl Image {
             .usage(vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST)
             .sharing_mode(vk::SharingMode::EXCLUSIVE)
             .initial_layout(vk::ImageLayout::UNDEFINED);
-        let image = unsafe { device.create_image(&info, None) }?;
-        let requirements = unsafe { device.get_image_memory_requirements(image) };
-        let memory = match allocate(&shared, requirements, false) {
-            Ok(m) => m,
-            Err(e) => {
-                unsafe { device.destroy_image(image, None) };
-                return Err(e);
-            }
+        let image = unsafe { ctx.device.create_image(&info, None) }?;
+        // From here on, Drop releases whatever has been created if a later step fails.
+        let mut result = Image {
+            shared: ctx.shared.clone(),
+            image,
+            view: vk::ImageView::null(),
+            memory: vk::DeviceMemory::null(),
+            format,
+            width,
+            height,
+            layers,
         };
-        unsafe { device.bind_image_memory(image, memory, 0) }?;
+        let device = &result.shared.device;
+        let requirements = unsafe { device.get_image_memory_requirements(image) };
+        result.memory = allocate(&result.shared, requirements, false)?;
+        unsafe { device.bind_image_memory(image, result.memory, 0) }?;
         let view_type = if array || layers > 1 { vk::ImageViewType::TYPE_2D_ARRAY } else { vk::ImageViewType::TYPE_2D };
         let view_info = vk::ImageViewCreateInfo::default()
             .image(image)
             .view_type(view_type)
             .format(format)
             .subresource_range(Image::range(layers));
-        let view = unsafe { device.create_image_view(&view_info, None) }?;
-        let result = Image { shared, image, view, memory, format, width, height, layers };
+        result.view = unsafe { device.create_image_view(&view_info, None) }?;
         ctx.run(|cmd| {
             result.transition_to_general(cmd);
             Ok(())

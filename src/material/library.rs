@@ -127,12 +127,6 @@ impl Library {
         Library { base: folder, search, look: Some(look_file.to_path_buf()) }
     }
 
-    /// Adds a folder to search for names after those already present (for a user library).
-    pub fn with_search_dir(mut self, dir: impl Into<PathBuf>) -> Library {
-        self.search.push(dir.into());
-        self
-    }
-
     /// Finds and loads the preset a layer names. The error is the problem alone, for the
     /// caller to place at the look's line; for a preset file with errors it carries that file's
     /// own `FILE:LINE`.

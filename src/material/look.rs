@@ -186,33 +186,21 @@ impl Look {
     }
 
     /// Applies `--set NAME=VALUE` to every layer of every object, after the look's own values,
-    /// and records it as an override so that [`Look::to_toml`] keeps it. `value` should come
-    /// from `params::parse_value`, which checks it; one of the wrong kind or range is ignored
-    /// with a warning.
-    pub fn set_everywhere(&mut self, param: Param, value: Value) {
+    /// and records it as an override so that [`Look::to_toml`] keeps it. A value of the wrong
+    /// kind or out of range changes nothing and is the error.
+    pub fn set_everywhere(&mut self, param: Param, value: Value) -> Result<(), String> {
+        super::params::check(param, value)?;
         for layer in self.objects.iter_mut().flat_map(|o| o.layers.iter_mut()) {
-            if let Err(problem) = layer.params.set(param, value) {
-                crate::warn(format!("ignoring --set: {problem}"));
-                return;
-            }
+            layer.params.set(param, value)?;
             if !layer.overrides.contains(&param) {
                 layer.overrides.push(param);
                 layer.overrides.sort();
             }
         }
+        Ok(())
     }
 
-    /// Every mask name that any layer references, the bottom layers' included, sorted and
-    /// deduplicated.
-    pub fn mask_names(&self) -> Vec<String> {
-        let mut names: Vec<String> =
-            self.objects.iter().flat_map(|o| &o.layers).filter_map(|l| l.mask.clone()).collect();
-        names.sort();
-        names.dedup();
-        names
-    }
-
-    /// The look in the §3 format: presets by their written name, overrides by value, the
+    /// The look in the look format: presets by their written name, overrides by value, the
     /// environment file relative to the look file's folder. Parsing it back (from the same
     /// path) gives an equal look.
     pub fn to_toml(&self) -> String {

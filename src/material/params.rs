@@ -76,6 +76,23 @@ impl Param {
         }
     }
 
+    /// Where the parameter sits in [`Params::to_gpu`]'s layout (a colour takes three places).
+    fn gpu_index(self) -> usize {
+        match self {
+            Param::BaseColor => 0,
+            Param::Metallic => 3,
+            Param::Subsurface => 4,
+            Param::Specular => 5,
+            Param::SpecularTint => 6,
+            Param::Roughness => 7,
+            Param::Anisotropic => 8,
+            Param::Sheen => 9,
+            Param::SheenTint => 10,
+            Param::Clearcoat => 11,
+            Param::ClearcoatGloss => 12,
+        }
+    }
+
     /// The names of all parameters, for error messages.
     pub fn all_names() -> String {
         Param::ALL.map(Param::name).join(", ")
@@ -144,9 +161,10 @@ pub const GPU_FLOATS: usize = 16;
 
 impl Params {
     pub fn get(&self, param: Param) -> Value {
+        let g = self.to_gpu();
         match param {
-            Param::BaseColor => Value::Color(self.base_color),
-            _ => Value::Scalar(*self.scalar_mut_ref(param)),
+            Param::BaseColor => Value::Color([g[0], g[1], g[2]]),
+            _ => Value::Scalar(g[param.gpu_index()]),
         }
     }
 
@@ -154,44 +172,13 @@ impl Params {
     /// the file or line, which the caller adds.
     pub fn set(&mut self, param: Param, value: Value) -> Result<(), String> {
         check(param, value)?;
-        match (param, value) {
-            (Param::BaseColor, Value::Color(c)) => self.base_color = c,
-            (_, Value::Scalar(v)) => *self.scalar_mut(param) = v,
-            _ => unreachable!("check() rejects a mismatched kind"),
+        let mut g = self.to_gpu();
+        match value {
+            Value::Color(c) => g[..3].copy_from_slice(&c),
+            Value::Scalar(v) => g[param.gpu_index()] = v,
         }
+        *self = Params::from_gpu(&g);
         Ok(())
-    }
-
-    fn scalar_mut_ref(&self, param: Param) -> &f32 {
-        match param {
-            Param::Metallic => &self.metallic,
-            Param::Subsurface => &self.subsurface,
-            Param::Specular => &self.specular,
-            Param::SpecularTint => &self.specular_tint,
-            Param::Roughness => &self.roughness,
-            Param::Anisotropic => &self.anisotropic,
-            Param::Sheen => &self.sheen,
-            Param::SheenTint => &self.sheen_tint,
-            Param::Clearcoat => &self.clearcoat,
-            Param::ClearcoatGloss => &self.clearcoat_gloss,
-            Param::BaseColor => unreachable!("base_color is a colour"),
-        }
-    }
-
-    fn scalar_mut(&mut self, param: Param) -> &mut f32 {
-        match param {
-            Param::Metallic => &mut self.metallic,
-            Param::Subsurface => &mut self.subsurface,
-            Param::Specular => &mut self.specular,
-            Param::SpecularTint => &mut self.specular_tint,
-            Param::Roughness => &mut self.roughness,
-            Param::Anisotropic => &mut self.anisotropic,
-            Param::Sheen => &mut self.sheen,
-            Param::SheenTint => &mut self.sheen_tint,
-            Param::Clearcoat => &mut self.clearcoat,
-            Param::ClearcoatGloss => &mut self.clearcoat_gloss,
-            Param::BaseColor => unreachable!("base_color is a colour"),
-        }
     }
 
     /// The GPU layout, mirrored by `glsl/include/material.glsl`:

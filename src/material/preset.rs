@@ -1,6 +1,6 @@
 //! Presets: named sets of BRDF parameter values, the building blocks of layer stacks.
 //!
-//! A preset file (`presets/<name>.toml`, a file beside a look, or later the user's library):
+//! A preset file (`presets/<name>.toml`, a file beside a look, or one in the user's library):
 //!
 //! ```toml
 //! name = "gold"                        # optional; defaults to the file name without .toml

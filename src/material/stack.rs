@@ -27,6 +27,25 @@ impl GpuLayer {
     }
 }
 
+/// Every mask the look names, on any layer of any stack, must be in the g-buffer.
+fn check_masks(look: &Look, look_name: &str, available: &[String], gbuffer_name: &Path) -> Result<()> {
+    for layer in look.objects.iter().flat_map(|o| &o.layers) {
+        let Some(name) = layer.mask.as_ref().filter(|m| !available.contains(m)) else {
+            continue;
+        };
+        let has = if available.is_empty() {
+            "no masks".to_string()
+        } else {
+            available.iter().map(|m| format!("mask.{m}")).collect::<Vec<_>>().join(", ")
+        };
+        return Err(Error::input_file(
+            format!("{look_name}:{}", layer.line),
+            format!("mask '{name}' is not in the g-buffer {} (it has {has})", gbuffer_name.display()),
+        ));
+    }
+    Ok(())
+}
+
 /// One stack as `resolve.comp` reads it: its first layer and how many layers it has.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
@@ -49,9 +68,10 @@ pub struct PackedStacks {
 
 impl PackedStacks {
     /// Packs the look's stacks for the objects in `object_ids` (those that are shaded). An object
-    /// with neither its own stack nor a default stack gets the default parameters (and a
-    /// warning). A mask the look names that `available_masks` lacks is an error naming both files
-    /// and the layer's line. Stack 0 always exists, for the pixels that shade nothing.
+    /// with neither its own stack nor a default stack gets the default parameters. A mask the
+    /// look names that `available_masks` lacks is an error naming both files and the layer's
+    /// line; a stack for an id the g-buffer does not show is reported. Stack 0 always exists,
+    /// for the pixels that shade nothing.
     pub fn pack(
         look: &Look,
         object_ids: impl IntoIterator<Item = u32>,
@@ -59,61 +79,43 @@ impl PackedStacks {
         gbuffer_name: &Path,
     ) -> Result<PackedStacks> {
         let look_name = look.file.as_deref().map(|p| p.display().to_string()).unwrap_or_else(|| "built-in look".into());
-        let mut masks: Vec<String> = Vec::new();
+        check_masks(look, &look_name, available_masks, gbuffer_name)?;
+        let object_ids: Vec<u32> = object_ids.into_iter().collect();
+        for stack in &look.objects {
+            if let Some(id) = stack.id.filter(|id| !object_ids.contains(id)) {
+                let line = stack.layers.first().map(|l| l.line).unwrap_or_default();
+                crate::warn(format!(
+                    "{look_name}:{line}: object id {id} is not in the g-buffer {}; its stack is unused",
+                    gbuffer_name.display()
+                ));
+            }
+        }
         let mut packed = PackedStacks {
             stacks: Vec::new(),
             layers: Vec::new(),
             masks: Vec::new(),
             stack_of_object: BTreeMap::new(),
         };
-        let mut unstyled = Vec::new();
         for id in object_ids {
             let first_layer = packed.layers.len() as u32;
-            match look.stack_for(id) {
-                Some(stack) => {
-                    for layer in &stack.layers {
-                        let mask = match &layer.mask {
-                            Some(name) if packed.layers.len() as u32 > first_layer => {
-                                if !available_masks.contains(name) {
-                                    return Err(Error::input_file(
-                                        format!("{look_name}:{}", layer.line),
-                                        format!(
-                                            "mask '{name}' is not in the g-buffer {} (it has {})",
-                                            gbuffer_name.display(),
-                                            if available_masks.is_empty() {
-                                                "no masks".to_string()
-                                            } else {
-                                                available_masks
-                                                    .iter()
-                                                    .map(|m| format!("mask.{m}"))
-                                                    .collect::<Vec<_>>()
-                                                    .join(", ")
-                                            }
-                                        ),
-                                    ));
-                                }
-                                let index = masks.iter().position(|m| m == name).unwrap_or_else(|| {
-                                    masks.push(name.clone());
-                                    masks.len() - 1
-                                });
-                                index as i32
-                            }
-                            // The bottom layer fills: its mask has no effect.
-                            _ => -1,
-                        };
-                        packed.layers.push(GpuLayer {
-                            params: layer.params.to_gpu(),
-                            mask,
-                            invert: layer.invert as u32,
-                            opacity: layer.opacity,
-                            pad: 0,
-                        });
-                    }
-                }
-                None => {
-                    unstyled.push(id);
-                    packed.layers.push(GpuLayer::default_material());
-                }
+            let layers = look.stack_for(id).map(|s| &s.layers[..]).unwrap_or_default();
+            for (i, layer) in layers.iter().enumerate() {
+                // The bottom layer fills: its mask has no effect.
+                let mask = match &layer.mask {
+                    Some(name) if i > 0 => packed.mask_index(name) as i32,
+                    _ => -1,
+                };
+                packed.layers.push(GpuLayer {
+                    params: layer.params.to_gpu(),
+                    mask,
+                    invert: layer.invert as u32,
+                    opacity: layer.opacity,
+                    pad: 0,
+                });
+            }
+            // An object with neither its own stack nor a default one gets the default material.
+            if layers.is_empty() {
+                packed.layers.push(GpuLayer::default_material());
             }
             let layer_count = packed.layers.len() as u32 - first_layer;
             packed.stack_of_object.insert(id, packed.stacks.len() as u32);
@@ -125,15 +127,15 @@ impl PackedStacks {
             packed.layers.push(GpuLayer::default_material());
             packed.stacks.push(GpuStack { first_layer: 0, layer_count: 1, pad: [0; 2] });
         }
-        if !unstyled.is_empty() {
-            let ids: Vec<String> = unstyled.iter().map(u32::to_string).collect();
-            crate::warn(format!(
-                "{look_name}: no stack for object id {} and no default stack; they get the default material",
-                ids.join(", ")
-            ));
-        }
-        packed.masks = masks;
         Ok(packed)
+    }
+
+    /// The GPU mask layer of a g-buffer mask, added on first use.
+    fn mask_index(&mut self, name: &str) -> usize {
+        self.masks.iter().position(|m| m == name).unwrap_or_else(|| {
+            self.masks.push(name.to_string());
+            self.masks.len() - 1
+        })
     }
 
     /// The blended material of one pixel, as `resolve.comp` computes it; `mask_value(i)` is the

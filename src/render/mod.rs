@@ -9,4 +9,4 @@ pub mod settings;
 pub mod sheet;
 pub mod tonemap;
 
-pub use renderer::{KernelTimes, Lighting, Renderer};
+pub use renderer::{Lighting, Renderer};

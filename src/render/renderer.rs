@@ -1,5 +1,5 @@
 //! The relighting engine: g-buffer, environment and layer stacks on the GPU; resolve, progressive
-//! relight passes, and display transforms. The CLI, the benchmark and the viewer all drive it.
+//! relight passes, and display transforms. Every command that renders drives it.
 
 use crate::environment::{self, Distribution, Environment, GpuEnvironment};
 use crate::gbuffer::GBuffer;
@@ -92,13 +92,6 @@ pub struct Renderer {
     samples: u32,
 }
 
-/// GPU time of the kernels a call ran, in seconds (None without timestamp support).
-#[derive(Clone, Copy, Debug, Default)]
-pub struct KernelTimes {
-    pub resolve: Option<f64>,
-    pub relight: Option<f64>,
-}
-
 fn float_image(ctx: &Context, width: u32, height: u32, layers: u32, data: &[[f32; 4]]) -> Result<Image> {
     let image = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, layers, layers > 1)?;
     image.upload(ctx, bytemuck::cast_slice(data))?;
@@ -186,16 +179,17 @@ impl Renderer {
         self.samples
     }
 
-    pub fn lighting(&self) -> Lighting {
-        self.lighting
-    }
-
     /// Changes the lighting; accumulation restarts if anything changed.
     pub fn set_lighting(&mut self, lighting: Lighting) {
         if lighting != self.lighting {
             self.lighting = lighting;
             self.samples = 0;
         }
+    }
+
+    /// Starts the accumulation over with everything unchanged.
+    pub fn restart(&mut self) {
+        self.samples = 0;
     }
 
     pub fn set_seed(&mut self, seed: u32) {
@@ -207,10 +201,10 @@ impl Renderer {
 
     /// Uploads new layer stacks and resolves them into one material per pixel (once per edit,
     /// not per sample). Accumulation restarts.
-    pub fn set_stacks(&mut self, packed: &PackedStacks) -> Result<KernelTimes> {
+    pub fn set_stacks(&mut self, packed: &PackedStacks) -> Result<()> {
         let ctx = &self.ctx;
         let (width, height) = (self.width, self.height);
-        let pixels = (width * height) as usize;
+        let pixels = self.object_ids.len();
         // Uncovered pixels may carry ids the stacks leave out; they shade nothing, so stack 0 does.
         let index: Vec<u32> =
             self.object_ids.iter().map(|id| packed.stack_of_object.get(id).copied().unwrap_or(0)).collect();
@@ -238,7 +232,7 @@ impl Renderer {
             ],
         )?;
         let groups = [group_count(width, LOCAL_SIZE_X), group_count(height, LOCAL_SIZE_Y), 1];
-        let time = self.timed(|renderer, cmd| renderer.resolve.dispatch(cmd, &[&set], &[], groups))?;
+        self.timed(|renderer, cmd| renderer.resolve.dispatch(cmd, &[&set], &[], groups))?;
         self.stacks = Some(GpuStacks {
             _stack_index: stack_index,
             _masks: masks,
@@ -247,7 +241,7 @@ impl Renderer {
             _set: set,
         });
         self.samples = 0;
-        Ok(KernelTimes { resolve: time, relight: None })
+        Ok(())
     }
 
     /// Runs `record` in one submission, bracketed by timestamps when the device has them.
@@ -297,9 +291,17 @@ impl Renderer {
     }
 
     /// Runs finalize.comp: the linear radiance image and the display pixels of the current sums.
+    /// Reading the image before the first pass would show whatever an earlier accumulation left.
+    fn check_rendered(&self) -> Result<()> {
+        if self.samples == 0 {
+            return Err(crate::Error::gpu("nothing has been rendered since the last change"));
+        }
+        Ok(())
+    }
+
     fn finalize(&self, cmd: vk::CommandBuffer, exposure: f32, tonemap: Tonemap) {
         let push = FinalizePush {
-            inverse_sample_count: 1.0 / self.samples.max(1) as f32,
+            inverse_sample_count: 1.0 / self.samples as f32,
             exposure_scale: exposure.exp2(),
             tonemap: tonemap.gpu_id(),
             show_background: self.lighting.background as u32,
@@ -312,6 +314,7 @@ impl Renderer {
     /// Linear radiance per pixel, row 0 at the top: rgb composited over the background with
     /// alpha 1, or, with the background off, premultiplied by coverage with alpha = coverage.
     pub fn read_radiance(&self) -> Result<Vec<[f32; 4]>> {
+        self.check_rendered()?;
         let staging = Buffer::staging(&self.ctx, self.radiance.byte_size())?;
         self.ctx.run(|cmd| {
             self.finalize(cmd, 0.0, Tonemap::Linear);
@@ -324,6 +327,7 @@ impl Renderer {
     /// Display pixels: exposure, tone map and sRGB, as RGBA8; straight alpha (the coverage) when
     /// the background is off, opaque otherwise.
     pub fn read_display(&self, exposure: f32, tonemap: Tonemap) -> Result<Vec<u8>> {
+        self.check_rendered()?;
         let staging = Buffer::staging(&self.ctx, self.display.byte_size())?;
         self.ctx.run(|cmd| {
             self.finalize(cmd, exposure, tonemap);
@@ -336,9 +340,5 @@ impl Renderer {
     /// The resolved material per pixel, as four layers of vec4 (for tests and inspection).
     pub fn read_resolved(&self) -> Result<Vec<[f32; 4]>> {
         Ok(bytemuck::cast_slice(&self.resolved.read(&self.ctx)?).to_vec())
-    }
-
-    pub fn context(&self) -> &Context {
-        &self.ctx
     }
 }

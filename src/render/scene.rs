@@ -55,7 +55,7 @@ impl Scene {
         let had_stacks = !look.objects.is_empty();
         let implicit_default = look.ensure_default_stack();
         for (param, value) in sets {
-            look.set_everywhere(*param, *value);
+            look.set_everywhere(*param, *value).map_err(crate::Error::input)?;
         }
         let settings = Settings::resolve(&look, overrides)?;
         let (gbuffer, gbuffer_name) = match gbuffer {
@@ -81,6 +81,28 @@ impl Scene {
             }
         }
         Scene::new(gbuffer, gbuffer_name, look, environment, settings)
+    }
+
+    /// Whether this device can hold the g-buffer: checked once the device is known, and
+    /// reported as bad input naming the file, since only a smaller g-buffer can fix it.
+    pub fn check_device(&self, info: &crate::gpu::DeviceInfo) -> Result<()> {
+        let max = info.max_image_dimension_2d;
+        let (w, h) = (self.gbuffer.width, self.gbuffer.height);
+        if w > max || h > max {
+            return Err(crate::Error::input_file(
+                &self.gbuffer_name,
+                format!("the g-buffer is {w}x{h}, larger than {}'s {max}-pixel image limit", info.name),
+            ));
+        }
+        if self.stacks.masks.len() as u32 > info.max_image_array_layers {
+            return Err(crate::Error::input(format!(
+                "the look uses {} masks, more than {}'s {} image layers",
+                self.stacks.masks.len(),
+                info.name,
+                info.max_image_array_layers
+            )));
+        }
+        Ok(())
     }
 }
 

@@ -8,8 +8,10 @@ use std::path::PathBuf;
 
 /// Samples per pixel when neither the look nor a flag says.
 pub const DEFAULT_SPP: u32 = 256;
+/// Exposures beyond this many stops overflow (or underflow) float radiance to inf (or 0).
+pub const MAX_EXPOSURE: f32 = 64.0;
 
-/// Values given on the command line (or by the viewer); `None` leaves the look's value.
+/// Values given on the command line; `None` leaves the look's value.
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
     pub environment: Option<PathBuf>,
@@ -53,6 +55,10 @@ impl Settings {
         if intensity < 0.0 {
             return Err(Error::input(format!("--intensity {intensity}: must be at least 0")));
         }
+        let exposure = finite("exposure", overrides.exposure.or(render.exposure).unwrap_or(0.0))?;
+        if exposure.abs() > MAX_EXPOSURE {
+            return Err(Error::input(format!("--exposure {exposure}: must be within ±{MAX_EXPOSURE} stops")));
+        }
         Ok(Settings {
             environment: overrides.environment.clone().or_else(|| env.file.clone()),
             lighting: Lighting {
@@ -62,7 +68,7 @@ impl Settings {
             },
             spp,
             seed: overrides.seed.or(render.seed).unwrap_or(0),
-            exposure: finite("exposure", overrides.exposure.or(render.exposure).unwrap_or(0.0))?,
+            exposure,
             tonemap: overrides.tonemap.or(render.tonemap).unwrap_or_default(),
         })
     }

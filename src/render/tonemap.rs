@@ -3,7 +3,7 @@
 use glam::{Mat3, Vec3};
 use std::fmt;
 
-/// The tone map applied to PNG output and the viewer, after exposure and before sRGB encoding.
+/// The tone map applied to PNG output, after exposure and before sRGB encoding.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Tonemap {
     /// Clamp to [0, 1].
@@ -45,7 +45,7 @@ impl fmt::Display for Tonemap {
     }
 }
 
-// The transforms below mirror glsl/include/tonemap.glsl function by function; `display.comp`
+// The transforms below mirror glsl/include/tonemap.glsl function by function; `finalize.comp`
 // runs them on the GPU and the tests compare the two.
 
 /// Khronos PBR Neutral (github.com/KhronosGroup/ToneMapping, PBR_Neutral).

@@ -1,0 +1,82 @@
+//! The flags every rendering command shares: lighting, sampling, display, and `--set`.
+
+use crate::environment::LoadOptions;
+use crate::material::{Param, Value};
+use crate::render::settings::Overrides;
+use crate::render::tonemap::Tonemap;
+use crate::Result;
+use clap::Args;
+use std::path::PathBuf;
+
+/// The environment and how it lights the scene.
+#[derive(Args, Debug, Default)]
+pub struct LightingArgs {
+    /// Equirectangular environment (default: the look's, else the embedded studio).
+    #[arg(long, value_name = "FILE.exr|.hdr")]
+    pub env: Option<PathBuf>,
+    /// Environment rotation about +Y, in degrees.
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    pub rotation: Option<f32>,
+    /// Environment radiance scale.
+    #[arg(long, value_name = "X")]
+    pub intensity: Option<f32>,
+    /// Show black (EXR: transparent) instead of the environment behind the objects.
+    #[arg(long)]
+    pub no_background: bool,
+    /// Read an environment that is not 2:1 as equirectangular anyway.
+    #[arg(long)]
+    pub env_any_aspect: bool,
+    /// Replace NaN, infinite and negative environment texels instead of refusing the file.
+    #[arg(long)]
+    pub env_clamp: bool,
+}
+
+impl LightingArgs {
+    pub fn load_options(&self) -> LoadOptions {
+        LoadOptions { any_aspect: self.env_any_aspect, clamp_invalid: self.env_clamp }
+    }
+}
+
+/// Samples per pixel and the sequence's seed.
+#[derive(Args, Debug, Default)]
+pub struct SamplingArgs {
+    /// Samples per pixel (each one environment and one BRDF sample).
+    #[arg(long, value_name = "N")]
+    pub spp: Option<u32>,
+    #[arg(long, value_name = "N")]
+    pub seed: Option<u32>,
+}
+
+/// How linear radiance becomes PNG pixels.
+#[derive(Args, Debug, Default)]
+pub struct DisplayArgs {
+    /// Exposure in stops, for PNG output.
+    #[arg(long, value_name = "EV", allow_hyphen_values = true)]
+    pub exposure: Option<f32>,
+    /// PNG tone map: linear, neutral (Khronos PBR Neutral), aces or agx.
+    #[arg(long, value_name = "NAME", value_parser = parse_tonemap)]
+    pub tonemap: Option<Tonemap>,
+}
+
+fn parse_tonemap(name: &str) -> std::result::Result<Tonemap, String> {
+    Tonemap::from_name(name).ok_or_else(|| format!("unknown tone map '{name}' (expected linear, neutral, aces, agx)"))
+}
+
+/// The command-line overrides of a look's settings.
+pub fn overrides(lighting: &LightingArgs, sampling: &SamplingArgs, display: &DisplayArgs) -> Overrides {
+    Overrides {
+        environment: lighting.env.clone(),
+        rotation: lighting.rotation,
+        intensity: lighting.intensity,
+        no_background: lighting.no_background,
+        spp: sampling.spp,
+        seed: sampling.seed,
+        exposure: display.exposure,
+        tonemap: display.tonemap,
+    }
+}
+
+/// Parses every `--set NAME=VALUE`.
+pub fn parse_sets(texts: &[String]) -> Result<Vec<(Param, Value)>> {
+    texts.iter().map(|t| super::parse_set(t)).collect()
+}
