@@ -184,12 +184,13 @@ fn gpu_relight_matches_the_cpu_mirror() {
             if error > 1e-3 {
                 off += 1;
                 // Float differences may flip a rare sampling decision; the result must still be close.
-                assert!(error < 0.25, "pixel ({x}, {y}): GPU {gpu} CPU {cpu}");
+                assert!(error < 0.1, "pixel ({x}, {y}): GPU {gpu} CPU {cpu}");
             }
         }
     }
     assert!(covered > 300, "{covered}");
-    assert!(off * 100 <= pixels, "{off} of {pixels} pixels differ by more than 0.1%");
+    eprintln!("{off} of {pixels} pixels differ by more than 0.1%");
+    assert!(off * 400 <= pixels, "{off} of {pixels} pixels differ by more than 0.1%");
     drop(r);
     common::gpu::finish(ctx);
 }
@@ -225,13 +226,27 @@ fn gpu_display_matches_the_rust_tonemaps() {
     r.render_samples(2).unwrap();
     let radiance = r.read_radiance().unwrap();
     let pixels = r.read_display(0.0, Tonemap::Linear).unwrap();
+    let mut partial = 0;
     for (i, rad) in radiance.iter().enumerate() {
         let alpha = (rad[3] * 255.0 + 0.5) as i32;
         assert!((pixels[4 * i + 3] as i32 - alpha).abs() <= 1, "pixel {i}: alpha {} vs {alpha}", pixels[4 * i + 3]);
         if rad[3] == 0.0 {
             assert_eq!(&pixels[4 * i..4 * i + 3], &[0, 0, 0]);
+        } else {
+            // The EXR radiance is premultiplied; the PNG colour is the surface's own.
+            let own = Vec3::new(rad[0], rad[1], rad[2]) / rad[3];
+            let expected = tonemap::display_pixel(own, 0.0, Tonemap::Linear);
+            for c in 0..3 {
+                assert!(
+                    (pixels[4 * i + c] as i32 - expected[c] as i32).abs() <= 1,
+                    "pixel {i}: {:?} vs {expected:?}",
+                    &pixels[4 * i..4 * i + 3]
+                );
+            }
+            partial += (rad[3] < 1.0) as usize;
         }
     }
+    assert!(partial > 10, "only {partial} partly covered pixels");
     drop(r);
     common::gpu::finish(ctx);
 }
