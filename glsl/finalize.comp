@@ -1,6 +1,6 @@
 #version 460
-// Turns the running sums into the image (README: Output): the mean estimate, composited over the
-// background by coverage, as linear radiance (for EXR); and, through exposure 2^EV, the tone
+// Turns the running sums of a band of rows into the image (README: Output): each pixel's mean
+// estimate, composited over the background by coverage, as linear radiance (for EXR); and, through exposure 2^EV, the tone
 // map and the sRGB OETF, as 8-bit display pixels (for PNG and the viewer).
 //
 // With the background on, both are opaque. With it off, the radiance is premultiplied by coverage
@@ -19,21 +19,23 @@ layout(set = 0, binding = 3, rgba32f) uniform writeonly image2D radiance;
 layout(set = 0, binding = 4, rgba8) uniform writeonly image2D display;
 
 layout(push_constant) uniform Finalize {
-    float inverse_sample_count;
     float exposure_scale;  // 2^EV
     uint tonemap;
     uint show_background;
+    uint first_row;        // the band this dispatch covers: rows first_row .. end_row - 1
+    uint end_row;
 } settings;
 
 void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.x, gl_GlobalInvocationID.y + settings.first_row);
     ivec2 size = imageSize(accumulation);
-    if (pixel.x >= size.x || pixel.y >= size.y) {
+    if (pixel.x >= size.x || pixel.y >= int(settings.end_row)) {
         return;
     }
     float coverage = imageLoad(surface, ivec3(pixel, 0)).w;
     // Uncovered pixels never write their sums, so those are not read.
-    vec3 surface_radiance = coverage > 0.0 ? imageLoad(accumulation, pixel).rgb * settings.inverse_sample_count : vec3(0.0);
+    vec4 sum = coverage > 0.0 ? imageLoad(accumulation, pixel) : vec4(0.0);
+    vec3 surface_radiance = sum.a > 0.0 ? sum.rgb / sum.a : vec3(0.0);
     vec4 linear;
     vec4 shown;
     if (settings.show_background != 0u) {

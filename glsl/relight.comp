@@ -1,9 +1,11 @@
 #version 460
-// One progressive pass of image-based relighting: for each covered pixel and each sample index,
-// one environment sample and one BRDF sample, combined with the power heuristic (README: Sampling).
-// The running float32 sum of the estimates is accumulated in sample order, so any split into
-// passes gives the same bits. Coverage and the background are composited by finalize.comp, so
-// background pixels cost nothing after the first pass of an accumulation.
+// One progressive pass of image-based relighting over a band of rows: for each covered pixel and
+// each sample index, one environment sample and one BRDF sample, combined with the power heuristic
+// (README: Sampling). The running float32 sum of the estimates is accumulated in sample order, so
+// any split into passes and bands gives the same bits. Coverage and the background are composited
+// by finalize.comp, so background pixels cost nothing after the first pass of an accumulation.
+// Every pixel of a band has the same number of samples so far; keeping that number (and so the
+// branches below) uniform across the dispatch matters on SIMD CPU drivers.
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 16, local_size_y = 16) in;
@@ -19,20 +21,22 @@ layout(local_size_x = 16, local_size_y = 16) in;
 layout(set = 0, binding = 0, rgba32f) uniform readonly image2DArray surface;
 // The resolved material, four layers as material.glsl unpacks them.
 layout(set = 0, binding = 1, rgba32f) uniform readonly image2DArray resolved;
-// Running sums of the radiance estimates of covered pixels (rgb); uncovered pixels are not written.
+// Covered pixels: the running sum of the radiance estimates (rgb) and their number (a).
+// Uncovered pixels are never written.
 layout(set = 0, binding = 2, rgba32f) uniform image2D accumulation;
 // The environment behind each pixel (rgb), written by the first pass of an accumulation.
 layout(set = 0, binding = 3, rgba32f) uniform writeonly image2D background;
 
 layout(push_constant) uniform Pass {
-    uint first_sample;     // 0 starts a new accumulation
+    uint first_sample;     // samples the band's pixels have; 0 starts a new accumulation
     uint sample_count;
     uint seed;
     uint show_background;
     float cos_rotation;
     float sin_rotation;
     float intensity;
-    uint image_width;
+    uint first_row;        // the band this dispatch covers: rows first_row .. end_row - 1
+    uint end_row;
 } pass;
 
 // R_y(−rotation)·d: world to environment space.
@@ -71,9 +75,9 @@ vec3 estimate(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, 
 }
 
 void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.x, gl_GlobalInvocationID.y + pass.first_row);
     ivec2 size = imageSize(accumulation);
-    if (pixel.x >= size.x || pixel.y >= size.y) {
+    if (pixel.x >= size.x || pixel.y >= int(pass.end_row)) {
         return;
     }
     vec4 normal_coverage = imageLoad(surface, ivec3(pixel, 0));
@@ -106,13 +110,13 @@ void main() {
         vec3 fx = to_environment(t);
         vec3 fy = to_environment(b);
         vec3 fn = to_environment(n);
-        uint pixel_seed = hash_combine(hash_u32(pass.seed), uint(pixel.y) * pass.image_width + uint(pixel.x));
+        uint pixel_seed = hash_combine(hash_u32(pass.seed), uint(pixel.y) * uint(size.x) + uint(pixel.x));
         uint env_seed = hash_combine(pixel_seed, 0x454e56u);
         uint brdf_seed = hash_combine(pixel_seed, 0x425244u);
-        uint last = pass.first_sample + pass.sample_count;
-        for (uint i = pass.first_sample; i < last; i++) {
+        for (uint i = pass.first_sample; i < pass.first_sample + pass.sample_count; i++) {
             sum.rgb += estimate(s, choice, view_terms, fx, fy, fn, sobol_owen_2d(i, env_seed), sobol_owen_2d(i, brdf_seed));
         }
     }
+    sum.a = float(pass.first_sample + pass.sample_count);
     imageStore(accumulation, pixel, sum);
 }

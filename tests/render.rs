@@ -270,6 +270,20 @@ fn renders_are_deterministic() {
     assert_eq!(a, render(&[16], 3));
     assert_eq!(a, render(&[1, 5, 10], 3));
     assert_ne!(a, render(&[16], 4));
+    // Bands of rows, as the viewer renders a frame's share, each at its own pace.
+    let mut r = renderer(&ctx, &gbuffer, &env, &look, Lighting::default());
+    r.set_seed(3);
+    r.render_rows(0, 20, 16).unwrap();
+    r.render_rows(20, 30, 6).unwrap();
+    r.render_rows(50, 100, 16).unwrap();
+    r.render_rows(20, 30, 10).unwrap();
+    assert_eq!(a, r.read_radiance().unwrap());
+    // A restart starts every pixel over, band by band, without clearing the image first.
+    r.set_seed(4);
+    r.render_rows(0, 40, 16).unwrap();
+    r.render_rows(40, 24, 16).unwrap();
+    assert_eq!(render(&[16], 4), r.read_radiance().unwrap());
+    drop(r);
     common::gpu::finish(ctx);
 }
 

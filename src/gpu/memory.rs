@@ -232,6 +232,19 @@ impl Image {
         }
     }
 
+    /// Records filling every layer with zeros.
+    pub fn record_clear(&self, cmd: vk::CommandBuffer) {
+        unsafe {
+            self.shared.device.cmd_clear_color_image(
+                cmd,
+                self.image,
+                vk::ImageLayout::GENERAL,
+                &vk::ClearColorValue::default(),
+                &[Image::range(self.layers)],
+            )
+        };
+    }
+
     pub fn byte_size(&self) -> u64 {
         self.width as u64 * self.height as u64 * self.layers as u64 * texel_size(self.format)
     }

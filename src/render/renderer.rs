@@ -41,17 +41,19 @@ struct RelightPush {
     cos_rotation: f32,
     sin_rotation: f32,
     intensity: f32,
-    image_width: u32,
+    first_row: u32,
+    end_row: u32,
 }
 
 /// `Finalize` in finalize.comp.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct FinalizePush {
-    inverse_sample_count: f32,
     exposure_scale: f32,
     tonemap: u32,
     show_background: u32,
+    first_row: u32,
+    end_row: u32,
 }
 
 /// The per-object material inputs on the GPU: which stack each pixel uses, the layers, the masks.
@@ -89,7 +91,8 @@ pub struct Renderer {
     timer: Option<GpuTimer>,
     lighting: Lighting,
     seed: u32,
-    samples: u32,
+    /// Samples each row has in the current accumulation.
+    row_samples: Vec<u32>,
 }
 
 fn float_image(ctx: &Context, width: u32, height: u32, layers: u32, data: &[[f32; 4]]) -> Result<Image> {
@@ -122,6 +125,7 @@ impl Renderer {
         let float_target = || Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 1, false);
         let accumulation = float_target()?;
         let background = float_target()?;
+
         let radiance = float_target()?;
         let display = Image::new(ctx, vk::Format::R8G8B8A8_UNORM, width, height, 1, false)?;
 
@@ -170,32 +174,32 @@ impl Renderer {
             timer: GpuTimer::new(ctx, 2)?,
             lighting: Lighting::default(),
             seed: 0,
-            samples: 0,
+            row_samples: vec![0; height as usize],
         })
     }
 
-    /// Samples per pixel accumulated since the last change.
+    /// Samples every pixel has accumulated since the last change.
     pub fn samples(&self) -> u32 {
-        self.samples
+        self.row_samples.iter().copied().min().unwrap_or(0)
     }
 
     /// Changes the lighting; accumulation restarts if anything changed.
     pub fn set_lighting(&mut self, lighting: Lighting) {
         if lighting != self.lighting {
             self.lighting = lighting;
-            self.samples = 0;
+            self.restart();
         }
     }
 
-    /// Starts the accumulation over with everything unchanged.
+    /// Starts a new accumulation with everything unchanged.
     pub fn restart(&mut self) {
-        self.samples = 0;
+        self.row_samples.fill(0);
     }
 
     pub fn set_seed(&mut self, seed: u32) {
         if seed != self.seed {
             self.seed = seed;
-            self.samples = 0;
+            self.restart();
         }
     }
 
@@ -240,7 +244,7 @@ impl Renderer {
             _layers: layer_buffer,
             _set: set,
         });
-        self.samples = 0;
+        self.restart();
         Ok(())
     }
 
@@ -265,48 +269,73 @@ impl Renderer {
 
     /// Accumulates `count` more samples per pixel in one dispatch. Returns its GPU time.
     pub fn render_samples(&mut self, count: u32) -> Result<Option<f64>> {
+        self.render_rows(0, self.height, count)
+    }
+
+    /// Accumulates `count` more samples for the pixels of rows `first_row..first_row + rows`
+    /// only: how the viewer bounds the work of one frame. Rows keep their own counts, so bands may
+    /// differ by a pass; [`Renderer::samples`] counts what every row has. Rows with different
+    /// counts take a dispatch each (usually there is one). Returns the GPU time.
+    pub fn render_rows(&mut self, first_row: u32, rows: u32, count: u32) -> Result<Option<f64>> {
         assert!(self.stacks.is_some(), "set_stacks() must run before rendering");
+        let end = first_row.saturating_add(rows).min(self.height);
+        let mut total = Some(0.0);
+        let mut start = first_row;
+        while start < end {
+            let first_sample = self.row_samples[start as usize];
+            let run_end = (start..end).find(|&r| self.row_samples[r as usize] != first_sample).unwrap_or(end);
+            let time = self.dispatch_relight(start, run_end, first_sample, count)?;
+            total = total.zip(time).map(|(a, b)| a + b);
+            self.row_samples[start as usize..run_end as usize].iter_mut().for_each(|n| *n += count);
+            start = run_end;
+        }
+        Ok(total)
+    }
+
+    fn dispatch_relight(&self, first_row: u32, end_row: u32, first_sample: u32, count: u32) -> Result<Option<f64>> {
         let rotation = self.lighting.rotation_degrees.to_radians();
         let push = RelightPush {
-            first_sample: self.samples,
+            first_sample,
             sample_count: count,
             seed: self.seed,
             show_background: self.lighting.background as u32,
             cos_rotation: rotation.cos(),
             sin_rotation: rotation.sin(),
             intensity: self.lighting.intensity,
-            image_width: self.width,
+            first_row,
+            end_row,
         };
-        let groups = [group_count(self.width, LOCAL_SIZE_X), group_count(self.height, LOCAL_SIZE_Y), 1];
-        let time = self.timed(|renderer, cmd| {
+        let groups = [group_count(self.width, LOCAL_SIZE_X), group_count(end_row - first_row, LOCAL_SIZE_Y), 1];
+        self.timed(|renderer, cmd| {
             renderer.relight.dispatch(
                 cmd,
                 &[&renderer.relight_set, &renderer.environment_set],
                 bytemuck::bytes_of(&push),
                 groups,
             )
-        })?;
-        self.samples += count;
-        Ok(time)
+        })
     }
 
-    /// Runs finalize.comp: the linear radiance image and the display pixels of the current sums.
     /// Reading the image before the first pass would show whatever an earlier accumulation left.
     fn check_rendered(&self) -> Result<()> {
-        if self.samples == 0 {
+        if self.row_samples.iter().all(|&n| n == 0) {
             return Err(crate::Error::gpu("nothing has been rendered since the last change"));
         }
         Ok(())
     }
 
-    fn finalize(&self, cmd: vk::CommandBuffer, exposure: f32, tonemap: Tonemap) {
+    /// Records finalize.comp over rows `first_row..first_row + rows`: the linear radiance image
+    /// and the display pixels of the current sums.
+    pub fn record_finalize(&self, cmd: vk::CommandBuffer, first_row: u32, rows: u32, exposure: f32, tonemap: Tonemap) {
         let push = FinalizePush {
-            inverse_sample_count: 1.0 / self.samples as f32,
             exposure_scale: exposure.exp2(),
             tonemap: tonemap.gpu_id(),
             show_background: self.lighting.background as u32,
+            first_row,
+            end_row: first_row + rows.min(self.height.saturating_sub(first_row)),
         };
-        let groups = [group_count(self.width, LOCAL_SIZE_X), group_count(self.height, LOCAL_SIZE_Y), 1];
+        let rows = rows.min(self.height.saturating_sub(first_row));
+        let groups = [group_count(self.width, LOCAL_SIZE_X), group_count(rows, LOCAL_SIZE_Y), 1];
         self.finalize.dispatch(cmd, &[&self.finalize_set], bytemuck::bytes_of(&push), groups);
         crate::gpu::context::full_barrier(&self.ctx.device, cmd);
     }
@@ -317,7 +346,7 @@ impl Renderer {
         self.check_rendered()?;
         let staging = Buffer::staging(&self.ctx, self.radiance.byte_size())?;
         self.ctx.run(|cmd| {
-            self.finalize(cmd, 0.0, Tonemap::Linear);
+            self.record_finalize(cmd, 0, self.height, 0.0, Tonemap::Linear);
             self.radiance.record_read(cmd, &staging);
             Ok(())
         })?;
@@ -330,7 +359,7 @@ impl Renderer {
         self.check_rendered()?;
         let staging = Buffer::staging(&self.ctx, self.display.byte_size())?;
         self.ctx.run(|cmd| {
-            self.finalize(cmd, exposure, tonemap);
+            self.record_finalize(cmd, 0, self.height, exposure, tonemap);
             self.display.record_read(cmd, &staging);
             Ok(())
         })?;
