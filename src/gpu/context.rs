@@ -38,6 +38,14 @@ pub struct DeviceInfo {
     pub subgroup_size: u32,
 }
 
+/// What presenting to a window needs of the context.
+pub struct Presentation<'a> {
+    /// Instance extensions the window system's surface needs.
+    pub instance_extensions: &'a [*const std::ffi::c_char],
+    /// Makes the window's surface once the instance exists.
+    pub create_surface: &'a dyn Fn(&ash::Entry, &ash::Instance) -> Result<vk::SurfaceKHR>,
+}
+
 /// The validation message counter, shared with the debug callback.
 #[derive(Default)]
 pub struct ValidationCounter {
@@ -53,7 +61,7 @@ impl ValidationCounter {
 /// Everything that must outlive every buffer, image and pipeline; they hold an `Arc` to it, so the
 /// device is destroyed only after the last of them.
 pub struct Shared {
-    _entry: ash::Entry,
+    pub entry: ash::Entry,
     pub instance: ash::Instance,
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     pub physical_device: vk::PhysicalDevice,
@@ -135,12 +143,35 @@ impl Context {
     /// Creates the context on the best device (discrete, then integrated, then CPU), or on the
     /// one whose name contains `options.device_name`.
     pub fn new(options: &ContextOptions) -> Result<Context> {
+        Context::create(options, None).map(|(ctx, _)| ctx)
+    }
+
+    /// A context that can also present to a window: the instance has the surface's extensions,
+    /// the device has the swapchain extension and dynamic rendering, and its queue can present
+    /// to the surface, which is returned for the caller to own (and destroy before the context).
+    pub fn with_surface(options: &ContextOptions, presentation: Presentation) -> Result<(Context, vk::SurfaceKHR)> {
+        let (ctx, surface) = Context::create(options, Some(presentation))?;
+        Ok((ctx, surface.expect("a surface was asked for")))
+    }
+
+    fn create(options: &ContextOptions, presentation: Option<Presentation>) -> Result<(Context, Option<vk::SurfaceKHR>)> {
         let entry = unsafe { ash::Entry::load() }
             .map_err(|e| Error::gpu(format!("no Vulkan loader found ({e}); {INSTALL_DRIVER}")))?;
         let counter = Arc::new(ValidationCounter::default());
-        let (instance, debug) = create_instance(&entry, options.validation, &counter)?;
-        let shared = pick_and_create_device(entry, instance, debug, options, counter.clone())?;
-        Ok(Context { shared: Arc::new(shared), counter })
+        let extra = presentation.as_ref().map(|p| p.instance_extensions).unwrap_or_default();
+        let (instance, debug) = create_instance(&entry, options.validation, extra, &counter)?;
+        let surface = match &presentation {
+            Some(p) => match (p.create_surface)(&entry, &instance) {
+                Ok(surface) => Some(surface),
+                Err(e) => {
+                    destroy_instance(&instance, &debug);
+                    return Err(e);
+                }
+            },
+            None => None,
+        };
+        let shared = pick_and_create_device(entry, instance, debug, options, surface, counter.clone())?;
+        Ok((Context { shared: Arc::new(shared), counter }, surface))
     }
 
     /// Validation errors reported so far (always 0 when validation is off).
@@ -154,6 +185,11 @@ impl Context {
         self.counter.clone()
     }
 
+    /// Holds the queue for a submission made outside [`Context::run`] (the viewer's frames).
+    pub fn lock_queue(&self) -> std::sync::MutexGuard<'_, ()> {
+        self.submission.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
     pub fn info(&self) -> &DeviceInfo {
         &self.shared.info
     }
@@ -163,7 +199,7 @@ impl Context {
     /// visible to the host, for read-backs.
     pub fn run<T>(&self, record: impl FnOnce(vk::CommandBuffer) -> Result<T>) -> Result<T> {
         let device = &self.device;
-        let _serialised = self.submission.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        let _serialised = self.lock_queue();
         unsafe {
             let alloc = vk::CommandBufferAllocateInfo::default()
                 .command_pool(self.command_pool)
@@ -234,6 +270,7 @@ type DebugMessenger = Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMes
 fn create_instance(
     entry: &ash::Entry,
     validation: bool,
+    extra_extensions: &[*const std::ffi::c_char],
     counter: &Arc<ValidationCounter>,
 ) -> Result<(ash::Instance, DebugMessenger)> {
     let app_name = CString::new("lookdev").expect("no interior NUL");
@@ -244,7 +281,7 @@ fn create_instance(
         .api_version(vk::API_VERSION_1_3);
 
     let mut layers = Vec::new();
-    let mut extensions = Vec::new();
+    let mut extensions = extra_extensions.to_vec();
     if validation {
         let available = unsafe { entry.enumerate_instance_layer_properties() }?;
         let found = available.iter().any(|l| l.layer_name_as_c_str().is_ok_and(|n| n == VALIDATION_LAYER));
@@ -287,39 +324,61 @@ fn create_instance(
     Ok((instance, Some((loader, messenger))))
 }
 
+fn destroy_instance(instance: &ash::Instance, debug: &DebugMessenger) {
+    unsafe {
+        if let Some((loader, messenger)) = debug {
+            loader.destroy_debug_utils_messenger(*messenger, None);
+        }
+        instance.destroy_instance(None);
+    }
+}
+
 fn pick_and_create_device(
     entry: ash::Entry,
     instance: ash::Instance,
     debug: DebugMessenger,
     options: &ContextOptions,
+    surface: Option<vk::SurfaceKHR>,
     counter: Arc<ValidationCounter>,
 ) -> Result<Shared> {
-    // From here on, a failure must still destroy the instance.
-    let destroy_instance = |instance: &ash::Instance, debug: &DebugMessenger| unsafe {
-        if let Some((loader, messenger)) = debug {
-            loader.destroy_debug_utils_messenger(*messenger, None);
+    // From here on, a failure must still destroy the surface and the instance.
+    let surface_loader = ash::khr::surface::Instance::new(&entry, &instance);
+    let give_up = |instance: &ash::Instance, debug: &DebugMessenger| {
+        if let Some(surface) = surface {
+            unsafe { surface_loader.destroy_surface(surface, None) };
         }
-        instance.destroy_instance(None);
+        destroy_instance(instance, debug);
     };
-    let chosen = match choose_physical_device(&instance, options) {
+    let presents = |pd: vk::PhysicalDevice, family: u32| match surface {
+        Some(surface) => {
+            unsafe { surface_loader.get_physical_device_surface_support(pd, family, surface) }.unwrap_or(false)
+        }
+        None => true,
+    };
+    let (physical_device, queue_family, info) = match choose_physical_device(&instance, options, surface.is_some(), &presents) {
         Ok(chosen) => chosen,
         Err(e) => {
-            destroy_instance(&instance, &debug);
+            give_up(&instance, &debug);
             return Err(e);
         }
     };
-    let (physical_device, queue_family, info) = chosen;
     let priorities = [1.0f32];
     let queue_info =
         [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
     // glslang's Vulkan 1.3 SPIR-V declares workgroup sizes with LocalSizeId, which needs maintenance4
-    // (core in 1.3 and supported by every 1.3 driver).
-    let mut features13 = vk::PhysicalDeviceVulkan13Features::default().maintenance4(true);
-    let device_info = vk::DeviceCreateInfo::default().queue_create_infos(&queue_info).push_next(&mut features13);
+    // (core in 1.3 and supported by every 1.3 driver). A window also needs dynamic rendering.
+    let mut features13 =
+        vk::PhysicalDeviceVulkan13Features::default().maintenance4(true).dynamic_rendering(surface.is_some());
+    let extensions: Vec<*const std::ffi::c_char> =
+        if surface.is_some() { vec![ash::khr::swapchain::NAME.as_ptr()] } else { Vec::new() };
+    let device_info = vk::DeviceCreateInfo::default()
+        .queue_create_infos(&queue_info)
+        .enabled_extension_names(&extensions)
+        .push_next(&mut features13);
     let device = match unsafe { instance.create_device(physical_device, &device_info, None) } {
         Ok(device) => device,
         Err(e) => {
-            destroy_instance(&instance, &debug);
+            give_up(&instance, &debug);
             return Err(Error::gpu(format!("cannot create a Vulkan device on {} ({e})", info.name)));
         }
     };
@@ -332,12 +391,12 @@ fn pick_and_create_device(
         Ok(pool) => pool,
         Err(e) => {
             unsafe { device.destroy_device(None) };
-            destroy_instance(&instance, &debug);
+            give_up(&instance, &debug);
             return Err(e.into());
         }
     };
     Ok(Shared {
-        _entry: entry,
+        entry,
         instance,
         debug,
         physical_device,
@@ -352,8 +411,13 @@ fn pick_and_create_device(
     })
 }
 
-/// The devices lookdev can use (Vulkan 1.3 with a compute queue), best first.
-fn candidates(instance: &ash::Instance) -> Result<Vec<(vk::PhysicalDevice, u32, DeviceInfo)>> {
+/// The devices lookdev can use (Vulkan 1.3 with a compute queue; with `graphics`, one that also
+/// draws and that `presents` accepts), best first.
+fn candidates(
+    instance: &ash::Instance,
+    graphics: bool,
+    presents: &dyn Fn(vk::PhysicalDevice, u32) -> bool,
+) -> Result<Vec<(vk::PhysicalDevice, u32, DeviceInfo)>> {
     let devices = unsafe { instance.enumerate_physical_devices() }?;
     let mut candidates = Vec::new();
     for pd in devices {
@@ -362,7 +426,10 @@ fn candidates(instance: &ash::Instance) -> Result<Vec<(vk::PhysicalDevice, u32, 
             continue;
         }
         let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
-        let Some(family) = families.iter().position(|f| f.queue_flags.contains(vk::QueueFlags::COMPUTE)) else {
+        let wanted = if graphics { vk::QueueFlags::COMPUTE | vk::QueueFlags::GRAPHICS } else { vk::QueueFlags::COMPUTE };
+        let Some(family) =
+            (0..families.len()).find(|&f| families[f].queue_flags.contains(wanted) && presents(pd, f as u32))
+        else {
             continue;
         };
         let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
@@ -387,8 +454,10 @@ fn candidates(instance: &ash::Instance) -> Result<Vec<(vk::PhysicalDevice, u32, 
 fn choose_physical_device(
     instance: &ash::Instance,
     options: &ContextOptions,
+    graphics: bool,
+    presents: &dyn Fn(vk::PhysicalDevice, u32) -> bool,
 ) -> Result<(vk::PhysicalDevice, u32, DeviceInfo)> {
-    let mut candidates = candidates(instance)?;
+    let mut candidates = candidates(instance, graphics, presents)?;
     if candidates.is_empty() {
         return Err(Error::gpu(format!("no Vulkan 1.3 device with a compute queue was found; {INSTALL_DRIVER}")));
     }
@@ -407,14 +476,9 @@ pub fn list_devices() -> Result<Vec<(String, String)>> {
     let entry = unsafe { ash::Entry::load() }
         .map_err(|e| Error::gpu(format!("no Vulkan loader found ({e}); {INSTALL_DRIVER}")))?;
     let counter = Arc::new(ValidationCounter::default());
-    let (instance, debug) = create_instance(&entry, false, &counter)?;
-    let candidates = candidates(&instance);
-    unsafe {
-        if let Some((loader, messenger)) = debug {
-            loader.destroy_debug_utils_messenger(messenger, None);
-        }
-        instance.destroy_instance(None);
-    }
+    let (instance, debug) = create_instance(&entry, false, &[], &counter)?;
+    let candidates = candidates(&instance, false, &|_, _| true);
+    destroy_instance(&instance, &debug);
     Ok(candidates?
         .into_iter()
         .map(|(_, _, info)| (info.name, format!("{:?}", info.device_type).to_lowercase().replace('_', " ")))

@@ -139,6 +139,8 @@ pub struct Image {
     shared: Arc<Shared>,
     pub image: vk::Image,
     pub view: vk::ImageView,
+    /// For an 8-bit display image: a view that samples it as sRGB (decoding to linear).
+    pub srgb_view: vk::ImageView,
     memory: vk::DeviceMemory,
     pub format: vk::Format,
     pub width: u32,
@@ -158,12 +160,31 @@ pub fn texel_size(format: vk::Format) -> u64 {
 impl Image {
     /// A storage image of `layers` layers (a 2D array view when `layers` > 1 or `array` is set).
     pub fn new(ctx: &Context, format: vk::Format, width: u32, height: u32, layers: u32, array: bool) -> Result<Image> {
+        Image::create(ctx, format, width, height, layers, array, false)
+    }
+
+    /// An RGBA8 storage image holding sRGB-encoded display pixels, which can also be sampled
+    /// through [`Image::srgb_view`] (the viewer shows it that way).
+    pub fn display(ctx: &Context, width: u32, height: u32) -> Result<Image> {
+        Image::create(ctx, vk::Format::R8G8B8A8_UNORM, width, height, 1, false, true)
+    }
+
+    fn create(
+        ctx: &Context,
+        format: vk::Format,
+        width: u32,
+        height: u32,
+        layers: u32,
+        array: bool,
+        sampled_as_srgb: bool,
+    ) -> Result<Image> {
         let max = ctx.info().max_image_dimension_2d;
         if width == 0 || height == 0 || width > max || height > max {
             return Err(Error::gpu(format!(
                 "a {width}x{height} image is outside what this device supports (1 to {max} pixels a side)"
             )));
         }
+        let usage = vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
@@ -172,7 +193,8 @@ impl Image {
             .array_layers(layers)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
-            .usage(vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST)
+            .usage(if sampled_as_srgb { usage | vk::ImageUsageFlags::SAMPLED } else { usage })
+            .flags(if sampled_as_srgb { vk::ImageCreateFlags::MUTABLE_FORMAT } else { vk::ImageCreateFlags::empty() })
             .sharing_mode(vk::SharingMode::EXCLUSIVE)
             .initial_layout(vk::ImageLayout::UNDEFINED);
         let image = unsafe { ctx.device.create_image(&info, None) }?;
@@ -181,6 +203,7 @@ impl Image {
             shared: ctx.shared.clone(),
             image,
             view: vk::ImageView::null(),
+            srgb_view: vk::ImageView::null(),
             memory: vk::DeviceMemory::null(),
             format,
             width,
@@ -198,6 +221,12 @@ impl Image {
             .format(format)
             .subresource_range(Image::range(layers));
         result.view = unsafe { device.create_image_view(&view_info, None) }?;
+        if sampled_as_srgb {
+            // sRGB formats cannot be storage images: this view is for sampling only.
+            let mut sampled_only = vk::ImageViewUsageCreateInfo::default().usage(vk::ImageUsageFlags::SAMPLED);
+            let srgb_info = view_info.format(vk::Format::R8G8B8A8_SRGB).push_next(&mut sampled_only);
+            result.srgb_view = unsafe { device.create_image_view(&srgb_info, None) }?;
+        }
         ctx.run(|cmd| {
             result.transition_to_general(cmd);
             Ok(())
@@ -303,6 +332,7 @@ impl Image {
 impl Drop for Image {
     fn drop(&mut self) {
         unsafe {
+            self.shared.device.destroy_image_view(self.srgb_view, None);
             self.shared.device.destroy_image_view(self.view, None);
             self.shared.device.destroy_image(self.image, None);
             self.shared.device.free_memory(self.memory, None);

@@ -7,7 +7,7 @@ pub mod pipeline;
 pub mod shaders;
 pub mod timer;
 
-pub use context::{Context, ContextOptions, DeviceInfo};
+pub use context::{Context, ContextOptions, DeviceInfo, Presentation};
 pub use memory::{Buffer, Image};
 pub use pipeline::{Binding, BindingKind, ComputePipeline, DescriptorSet};
 pub use timer::GpuTimer;

@@ -127,7 +127,7 @@ impl Renderer {
         let background = float_target()?;
 
         let radiance = float_target()?;
-        let display = Image::new(ctx, vk::Format::R8G8B8A8_UNORM, width, height, 1, false)?;
+        let display = Image::display(ctx, width, height)?;
 
         let distribution = Distribution::for_device(environment, ctx.info().max_image_dimension_2d);
         let gpu_environment = GpuEnvironment::upload(ctx, environment, &distribution)?;
