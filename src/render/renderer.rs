@@ -178,6 +178,16 @@ impl Renderer {
         })
     }
 
+    /// Replaces the environment (its texels and sampling tables); accumulation restarts.
+    pub fn set_environment(&mut self, environment: &Environment) -> Result<()> {
+        let distribution = Distribution::for_device(environment, self.ctx.info().max_image_dimension_2d);
+        let gpu_environment = GpuEnvironment::upload(&self.ctx, environment, &distribution)?;
+        self.environment_set = self.relight.bind(1, &gpu_environment.bindings())?;
+        self._environment = gpu_environment;
+        self.restart();
+        Ok(())
+    }
+
     /// Samples every pixel has accumulated since the last change.
     pub fn samples(&self) -> u32 {
         self.row_samples.iter().copied().min().unwrap_or(0)
@@ -338,6 +348,20 @@ impl Renderer {
         let groups = [group_count(self.width, LOCAL_SIZE_X), group_count(rows, LOCAL_SIZE_Y), 1];
         self.finalize.dispatch(cmd, &[&self.finalize_set], bytemuck::bytes_of(&push), groups);
         crate::gpu::context::full_barrier(&self.ctx.device, cmd);
+    }
+
+    /// Makes the display pixels (and linear radiance) of rows `first_row..first_row + rows` from
+    /// their current sums, for the viewer to show.
+    pub fn finalize_rows(&self, first_row: u32, rows: u32, exposure: f32, tonemap: Tonemap) -> Result<()> {
+        self.ctx.run(|cmd| {
+            self.record_finalize(cmd, first_row, rows, exposure, tonemap);
+            Ok(())
+        })
+    }
+
+    /// The display image (sRGB-encoded RGBA8), which the viewer samples through its sRGB view.
+    pub fn display_image(&self) -> &Image {
+        &self.display
     }
 
     /// Linear radiance per pixel, row 0 at the top: rgb composited over the background with

@@ -1,0 +1,160 @@
+//! egui on Vulkan: input from winit, drawing through egui-ash-renderer into the swapchain image,
+//! and the rendered view shown as an egui texture.
+
+use super::presenter::Presenter;
+use crate::gpu::{Context, Image};
+use crate::{Error, Result};
+use ash::vk;
+use egui_ash_renderer::{DynamicRendering, Options, RenderMode, Renderer};
+use winit::window::Window;
+
+/// The egui context and what draws it.
+pub struct Gui {
+    ctx: Context,
+    pub egui: egui::Context,
+    state: egui_winit::State,
+    renderer: Renderer<egui_ash_renderer::allocator::DefaultAllocator>,
+    view_texture: Option<ViewTexture>,
+}
+
+/// The rendered view as a texture egui can draw: a sampler set over the display image.
+struct ViewTexture {
+    id: egui::TextureId,
+    pool: vk::DescriptorPool,
+    layout: vk::DescriptorSetLayout,
+    sampler: vk::Sampler,
+    image_view: vk::ImageView,
+}
+
+fn renderer_error(e: impl std::fmt::Display) -> Error {
+    Error::gpu(format!("the user interface renderer failed ({e})"))
+}
+
+impl Gui {
+    pub fn new(ctx: &Context, window: &Window, presenter: &Presenter) -> Result<Gui> {
+        let egui = egui::Context::default();
+        let state = egui_winit::State::new(egui.clone(), egui::ViewportId::ROOT, window, None, None, None);
+        let renderer = Renderer::with_default_allocator(
+            &ctx.instance,
+            ctx.physical_device,
+            ctx.device.clone(),
+            RenderMode::DynamicRendering(DynamicRendering {
+                color_attachment_format: presenter.format,
+                depth_attachment_format: None,
+                stencil_attachment_format: None,
+            }),
+            Options { in_flight_frames: 1, srgb_framebuffer: true, ..Options::default() },
+        )
+        .map_err(renderer_error)?;
+        Ok(Gui { ctx: ctx.clone(), egui, state, renderer, view_texture: None })
+    }
+
+    /// Passes a window event to egui; true when egui used it.
+    pub fn on_event(&mut self, window: &Window, event: &winit::event::WindowEvent) -> bool {
+        self.state.on_window_event(window, event).consumed
+    }
+
+    /// The texture id of the rendered view, made (or remade) for `image`.
+    pub fn view_texture(&mut self, image: &Image) -> Result<egui::TextureId> {
+        if let Some(texture) = &self.view_texture {
+            if texture.image_view == image.srgb_view {
+                return Ok(texture.id);
+            }
+        }
+        self.release_view_texture();
+        let device = &self.ctx.device;
+        let layout = egui_ash_renderer::vulkan::create_vulkan_descriptor_set_layout(device).map_err(renderer_error)?;
+        let sizes = [vk::DescriptorPoolSize::default().ty(vk::DescriptorType::COMBINED_IMAGE_SAMPLER).descriptor_count(1)];
+        let pool = unsafe { device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None) }?;
+        // Nearest filtering: zoomed in, an artist inspects pixels, not a blur of them.
+        let sampler_info = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::NEAREST)
+            .min_filter(vk::Filter::LINEAR)
+            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE);
+        let sampler = unsafe { device.create_sampler(&sampler_info, None) }?;
+        let layouts = [layout];
+        let set = unsafe {
+            device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts))
+        }?[0];
+        let info = [vk::DescriptorImageInfo::default()
+            .sampler(sampler)
+            .image_view(image.srgb_view)
+            .image_layout(vk::ImageLayout::GENERAL)];
+        let write = vk::WriteDescriptorSet::default()
+            .dst_set(set)
+            .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+            .image_info(&info);
+        unsafe { device.update_descriptor_sets(&[write], &[]) };
+        let id = self.renderer.add_user_texture(set);
+        self.view_texture = Some(ViewTexture { id, pool, layout, sampler, image_view: image.srgb_view });
+        Ok(id)
+    }
+
+    fn release_view_texture(&mut self) {
+        if let Some(texture) = self.view_texture.take() {
+            self.renderer.remove_user_texture(texture.id);
+            let device = &self.ctx.device;
+            unsafe {
+                let _ = device.device_wait_idle();
+                device.destroy_descriptor_pool(texture.pool, None);
+                device.destroy_descriptor_set_layout(texture.layout, None);
+                device.destroy_sampler(texture.sampler, None);
+            }
+        }
+    }
+
+    /// Runs the UI for one frame and draws it. Returns the captured window when `capture` is set
+    /// (see [`Presenter::frame`]).
+    pub fn frame(
+        &mut self,
+        window: &Window,
+        presenter: &mut Presenter,
+        capture: bool,
+        ui: impl FnMut(&egui::Context),
+    ) -> Result<Option<image::RgbaImage>> {
+        let input = self.state.take_egui_input(window);
+        let output = self.egui.run(input, ui);
+        self.state.handle_platform_output(window, output.platform_output);
+        let primitives = self.egui.tessellate(output.shapes, output.pixels_per_point);
+        for (id, delta) in &output.textures_delta.set {
+            let _queue = self.ctx.lock_queue();
+            self.renderer.set_texture(self.ctx.queue, presenter.pool(), *id, delta).map_err(renderer_error)?;
+        }
+        let renderer = &mut self.renderer;
+        let device = self.ctx.device.clone();
+        let captured = presenter.frame(capture, |cmd, view, extent| {
+            let attachments = [vk::RenderingAttachmentInfo::default()
+                .image_view(view)
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.02, 0.02, 0.025, 1.0] } })];
+            let info = vk::RenderingInfo::default()
+                .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent })
+                .layer_count(1)
+                .color_attachments(&attachments);
+            unsafe { device.cmd_begin_rendering(cmd, &info) };
+            renderer.cmd_draw(cmd, extent, output.pixels_per_point, &primitives).map_err(renderer_error)?;
+            unsafe { device.cmd_end_rendering(cmd) };
+            Ok(())
+        })?;
+        if !output.textures_delta.free.is_empty() {
+            unsafe { self.ctx.device.device_wait_idle() }?;
+            for id in &output.textures_delta.free {
+                self.renderer.free_texture(*id).map_err(renderer_error)?;
+            }
+        }
+        Ok(captured)
+    }
+}
+
+impl Drop for Gui {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.ctx.device.device_wait_idle();
+        }
+        self.release_view_texture();
+    }
+}

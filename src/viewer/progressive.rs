@@ -1,0 +1,86 @@
+//! Progressive rendering bounded per frame: each frame relights a band of rows with one sample,
+//! sized so the frame stays responsive; a full pass is done when the band has swept the image.
+//! On a fast device a band is the whole image, so a change shows within one frame.
+
+use crate::render::tonemap::Tonemap;
+use crate::render::Renderer;
+use crate::Result;
+use std::time::{Duration, Instant};
+
+/// Relighting time allowed per frame.
+const FRAME_BUDGET: Duration = Duration::from_millis(25);
+/// The smallest band, so a slow device still makes progress each frame.
+const MIN_BAND_ROWS: u32 = 8;
+
+/// Where the sweep is, how fast rows relight, and the figures the status bar shows.
+pub struct Progressive {
+    cursor: u32,
+    band_rows: u32,
+    /// Seconds to relight one row with one sample (a running average).
+    row_seconds: f64,
+    /// When the current accumulation started, and when its first full pass landed.
+    started: Instant,
+    pub first_pass: Option<Duration>,
+    /// Pixel samples relit, and the time spent, over the current accumulation.
+    pixel_samples: f64,
+    busy: Duration,
+}
+
+impl Progressive {
+    pub fn new(height: u32) -> Progressive {
+        Progressive {
+            cursor: 0,
+            band_rows: height.max(1),
+            row_seconds: 0.0,
+            started: Instant::now(),
+            first_pass: None,
+            pixel_samples: 0.0,
+            busy: Duration::ZERO,
+        }
+    }
+
+    /// Starts over after an edit: the renderer has restarted its accumulation.
+    pub fn restart(&mut self) {
+        self.cursor = 0;
+        self.started = Instant::now();
+        self.first_pass = None;
+        self.pixel_samples = 0.0;
+        self.busy = Duration::ZERO;
+    }
+
+    /// Relights the next band if the image has fewer than `target` samples, then makes its
+    /// display pixels. Returns whether anything was rendered.
+    pub fn step(&mut self, renderer: &mut Renderer, target: u32, exposure: f32, tonemap: Tonemap) -> Result<bool> {
+        if renderer.samples() >= target {
+            return Ok(false);
+        }
+        let height = renderer.height;
+        let rows = self.band_rows.clamp(MIN_BAND_ROWS.min(height), height - self.cursor);
+        let start = Instant::now();
+        renderer.render_rows(self.cursor, rows, 1)?;
+        renderer.finalize_rows(self.cursor, rows, exposure, tonemap)?;
+        let elapsed = start.elapsed();
+        self.busy += elapsed;
+        self.pixel_samples += rows as f64 * renderer.width as f64;
+        let per_row = elapsed.as_secs_f64() / rows as f64;
+        self.row_seconds = if self.row_seconds == 0.0 { per_row } else { 0.7 * self.row_seconds + 0.3 * per_row };
+        self.band_rows = ((FRAME_BUDGET.as_secs_f64() / self.row_seconds.max(1e-9)) as u32).clamp(MIN_BAND_ROWS, height);
+        self.cursor += rows;
+        if self.cursor >= height {
+            self.cursor = 0;
+            if self.first_pass.is_none() {
+                self.first_pass = Some(self.started.elapsed());
+            }
+        }
+        Ok(true)
+    }
+
+    /// Pixel samples per second while relighting, over the current accumulation.
+    pub fn samples_per_second(&self) -> f64 {
+        if self.busy.is_zero() {
+            0.0
+        } else {
+            self.pixel_samples / self.busy.as_secs_f64()
+        }
+    }
+}
