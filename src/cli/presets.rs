@@ -230,6 +230,7 @@ fn preset_on_ball(preset: &Preset) -> Look {
         mask: None,
         invert: false,
         opacity: 1.0,
+        enabled: true,
         line: 0,
     };
     let pedestal = Params { base_color: [0.18; 3], roughness: 0.6, ..Params::default() };
