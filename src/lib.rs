@@ -2,7 +2,8 @@
 //!
 //! Data flows one way: files are read into validated Rust types ([`gbuffer`], [`environment`],
 //! [`material`]), uploaded to the GPU ([`gpu`]), relit by compute kernels ([`render`]) and written
-//! out as images.
+//! out as images. [`viewer_state`] is the document an interactive viewer edits, with undo and
+//! saving; it needs no GPU.
 
 pub mod atomic_file;
 pub mod cli;
@@ -13,6 +14,7 @@ pub mod gpu;
 pub mod material;
 pub mod render;
 pub mod shading;
+pub mod viewer_state;
 
 pub use error::{Error, ErrorKind, Result};
 

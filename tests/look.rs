@@ -65,8 +65,8 @@ fn unknown_keys_name_the_table_and_the_expected_keys() {
     );
     assert_eq!(
         error("[[object]]\nid = 1\n[[object.layer]]\npreset = \"gold\"\nmaks = \"stripes\"\n"),
-        "looks/shot.toml:5: unknown key 'maks' in [[object.layer]] (expected preset, mask, invert, opacity, set); \
-         did you mean 'mask'?"
+        "looks/shot.toml:5: unknown key 'maks' in [[object.layer]] (expected preset, mask, invert, opacity, enabled, \
+         set); did you mean 'mask'?"
     );
     assert_eq!(
         error("[[object]]\nname = \"ball\"\n[[object.layer]]\n"),
@@ -152,6 +152,7 @@ fn layer_values_are_checked() {
         "looks/shot.toml:5: invert must be true or false, not the string \"yes\""
     );
     assert_eq!(error(&layer("mask = \"\"")), "looks/shot.toml:5: mask must not be empty");
+    assert_eq!(error(&layer("enabled = 0")), "looks/shot.toml:5: enabled must be true or false, not the integer 0");
     assert_eq!(error(&layer("preset = 7")), "looks/shot.toml:5: preset must be a string, not the integer 7");
 }
 
@@ -370,6 +371,24 @@ clearcoat = 2.5
     let mut again = Look::parse(&builtin.to_toml(), Path::new(SHOT)).unwrap();
     again.file = None;
     assert_eq!(again, builtin);
+}
+
+#[test]
+fn layers_can_be_disabled_and_stay_so_when_written_back() {
+    let text = "[[object]]\nid = 1\n[[object.layer]]\npreset = \"gold\"\n[[object.layer]]\npreset = \"grime\"\n\
+                enabled = false\n[[object.layer]]\npreset = \"wax\"\nenabled = true\n";
+    let look = Look::parse(text, Path::new(SHOT)).unwrap();
+    let enabled: Vec<bool> = look.objects[0].layers.iter().map(|l| l.enabled).collect();
+    assert_eq!(enabled, [true, false, true], "enabled defaults to true");
+
+    let written = look.to_toml();
+    assert_eq!(written.matches("enabled = false").count(), 1, "{written}");
+    assert!(!written.contains("enabled = true"), "only the non-default value is written: {written}");
+    assert_eq!(Look::parse(&written, Path::new(SHOT)).unwrap(), look);
+
+    let mut enabled = look.clone();
+    enabled.objects[0].layers[1].enabled = true;
+    assert_ne!(enabled, look, "enabled is part of what a layer means");
 }
 
 #[test]

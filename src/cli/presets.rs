@@ -11,7 +11,7 @@ use crate::material::Preset;
 use crate::render::batch::Batch;
 use crate::render::settings::Settings;
 use crate::render::sheet::{self, Cell};
-use crate::{atomic_file, Error, Result};
+use crate::{Error, Result};
 use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
 
@@ -150,19 +150,9 @@ fn show(name: &str) -> Result<()> {
     Ok(())
 }
 
-fn valid_name(name: &str) -> bool {
-    !name.is_empty() && name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '_')
-}
-
 fn save(args: SaveArgs) -> Result<()> {
-    if !valid_name(&args.name) {
-        return Err(Error::input(format!(
-            "'{}' is not a preset name: use lowercase letters, digits, '-' and '_'",
-            args.name
-        )));
-    }
-    let dir =
-        library::user_library_dir().ok_or_else(|| Error::input("no user library: set LOOKDEV_PRESETS or HOME"))?;
+    library::check_preset_name(&args.name)?;
+    let dir = library::require_user_library_dir()?;
     let (params, set) = match &args.from_look {
         Some(look) => layer_params(look, args.object.as_deref().unwrap_or_default(), args.layer.unwrap_or(0))?,
         None if args.set.is_empty() => {
@@ -181,15 +171,8 @@ fn save(args: SaveArgs) -> Result<()> {
     };
     let mut set: Vec<Param> = Param::ALL.into_iter().filter(|p| set.contains(p)).collect();
     set.dedup();
-    let preset = Preset { name: args.name.clone(), description: args.description, tags: args.tags, params, set };
-    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, format!("cannot create the user library: {e}")))?;
-    let path = dir.join(format!("{}.toml", args.name));
-    let text = preset.to_toml();
-    if args.force {
-        atomic_file::write(&path, text.as_bytes())?;
-    } else {
-        atomic_file::write_new(&path, text.as_bytes())?;
-    }
+    let preset = Preset { name: args.name, description: args.description, tags: args.tags, params, set };
+    let path = library::save_preset(&dir, &preset, args.force)?;
     println!("{}", path.display());
     Ok(())
 }
@@ -230,6 +213,7 @@ fn preset_on_ball(preset: &Preset) -> Look {
         mask: None,
         invert: false,
         opacity: 1.0,
+        enabled: true,
         line: 0,
     };
     let pedestal = Params { base_color: [0.18; 3], roughness: 0.6, ..Params::default() };

@@ -26,6 +26,40 @@ pub fn user_library_dir() -> Option<PathBuf> {
         .or_else(|| var("HOME").map(|h| h.join(".local/share/lookdev/presets")))
 }
 
+/// The user library, or the error saying how to have one.
+pub fn require_user_library_dir() -> crate::Result<PathBuf> {
+    user_library_dir().ok_or_else(|| crate::Error::input("no user library: set LOOKDEV_PRESETS or HOME"))
+}
+
+/// A name a preset may be saved under: lowercase letters, digits, '-' and '_', so that it is a
+/// file name everywhere and never looks like a path.
+pub fn check_preset_name(name: &str) -> crate::Result<()> {
+    let valid =
+        !name.is_empty() && name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '_');
+    if valid {
+        Ok(())
+    } else {
+        Err(crate::Error::input(format!("'{name}' is not a preset name: use lowercase letters, digits, '-' and '_'")))
+    }
+}
+
+/// Writes `preset` as `<dir>/<name>.toml`, creating `dir` if needed, and returns the path. The
+/// write is atomic; without `force` an existing preset is refused, and the check and the write
+/// are one step.
+pub fn save_preset(dir: &Path, preset: &Preset, force: bool) -> crate::Result<PathBuf> {
+    check_preset_name(&preset.name)?;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| crate::Error::io(dir, format!("cannot create the preset library: {e}")))?;
+    let path = dir.join(format!("{}.toml", preset.name));
+    let text = preset.to_toml();
+    if force {
+        crate::atomic_file::write(&path, text.as_bytes())?;
+    } else {
+        crate::atomic_file::write_new(&path, text.as_bytes())?;
+    }
+    Ok(path)
+}
+
 /// Names already reported as shadowing a built-in preset, so each is reported once.
 static REPORTED_SHADOWS: Mutex<BTreeSet<String>> = Mutex::new(BTreeSet::new());
 

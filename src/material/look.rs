@@ -23,13 +23,16 @@
 //! mask = "scratches"     # the g-buffer channel mask.scratches; omitted = 1 everywhere
 //! invert = false
 //! opacity = 1.0          # [0, 1]
+//! enabled = true         # false keeps the layer but leaves it out of the render
 //! [object.layer.set]     # per-parameter overrides on top of the preset
 //! roughness = 0.25
 //! ```
 //!
 //! A layer without `preset` starts from the default parameters. The bottom layer fills the
 //! object: its mask, invert and opacity are accepted (and written back) but have no effect, and
-//! loading warns about them. Every error is one line, `FILE:LINE: problem`, naming the key.
+//! loading warns about them. A disabled layer is kept (and written back) but not rendered; when
+//! the bottom layer is disabled, the lowest enabled layer fills. Every error is one line,
+//! `FILE:LINE: problem`, naming the key.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -102,6 +105,9 @@ pub struct Layer {
     pub invert: bool,
     /// In [0, 1].
     pub opacity: f32,
+    /// `enabled = false` keeps the layer in the look but leaves it out of rendering, so an
+    /// artist can compare with and without it.
+    pub enabled: bool,
     /// The 1-based line of this `[[object.layer]]` in the file, for later error messages
     /// (such as a mask the g-buffer lacks).
     pub line: usize,
@@ -117,6 +123,7 @@ impl PartialEq for Layer {
             && self.mask == other.mask
             && self.invert == other.invert
             && self.opacity == other.opacity
+            && self.enabled == other.enabled
     }
 }
 
@@ -173,6 +180,7 @@ impl Look {
             mask: None,
             invert: false,
             opacity: 1.0,
+            enabled: true,
             line: 0,
         };
         self.objects.push(ObjectStack { id: None, layers: vec![layer] });
@@ -274,6 +282,9 @@ impl Layer {
         if self.opacity != 1.0 {
             lines.push(format!("opacity = {}", input::float(self.opacity)));
         }
+        if !self.enabled {
+            lines.push("enabled = false".to_string());
+        }
         if !self.overrides.is_empty() {
             lines.push("[object.layer.set]".to_string());
             for &param in &self.overrides {
@@ -342,6 +353,7 @@ struct LayerFile {
     mask: Option<Field>,
     invert: Option<Field>,
     opacity: Option<Field>,
+    enabled: Option<Field>,
     /// Parameter name to value; names are checked here rather than by serde so that an unknown
     /// one can be reported as a parameter, with the closest name.
     set: Option<BTreeMap<Field<String>, Field>>,
@@ -432,6 +444,7 @@ fn layer(src: &Source, raw: &Field<LayerFile>, library: &Library) -> crate::Resu
         mask: src.read("mask", &fields.mask, input::text)?,
         invert: src.read("invert", &fields.invert, input::boolean)?.unwrap_or(false),
         opacity: src.read("opacity", &fields.opacity, unit_interval)?.unwrap_or(1.0),
+        enabled: src.read("enabled", &fields.enabled, input::boolean)?.unwrap_or(true),
         line: src.line(raw.span().start),
     })
 }

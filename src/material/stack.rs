@@ -2,7 +2,7 @@
 //! with their own materials, and the masks they use. `resolve.comp` blends them per pixel; the
 //! CPU [`PackedStacks::resolve_pixel`] mirrors it for tests and for inspecting pixels.
 
-use super::look::Look;
+use super::look::{Layer, Look};
 use super::params::Params;
 use crate::{Error, Result};
 use std::collections::BTreeMap;
@@ -27,7 +27,8 @@ impl GpuLayer {
     }
 }
 
-/// Every mask the look names, on any layer of any stack, must be in the g-buffer.
+/// Every mask the look names, on any layer of any stack, must be in the g-buffer. Disabled layers
+/// count too, so that enabling one is never what breaks a render.
 fn check_masks(look: &Look, look_name: &str, available: &[String], gbuffer_name: &Path) -> Result<()> {
     for layer in look.objects.iter().flat_map(|o| &o.layers) {
         let Some(name) = layer.mask.as_ref().filter(|m| !available.contains(m)) else {
@@ -67,8 +68,10 @@ pub struct PackedStacks {
 }
 
 impl PackedStacks {
-    /// Packs the look's stacks for the objects in `object_ids` (those that are shaded). An object
-    /// with neither its own stack nor a default stack gets the default parameters. A mask the
+    /// Packs the look's stacks for the objects in `object_ids` (those that are shaded). Disabled
+    /// layers are left out, so the lowest enabled layer is the one that fills. An object with
+    /// neither its own stack nor a default stack, or whose layers are all disabled, gets the
+    /// default parameters. A mask the
     /// look names that `available_masks` lacks is an error naming both files and the layer's
     /// line; a stack for an id the g-buffer does not show is reported. Stack 0 always exists,
     /// for the pixels that shade nothing.
@@ -98,7 +101,8 @@ impl PackedStacks {
         };
         for id in object_ids {
             let first_layer = packed.layers.len() as u32;
-            let layers = look.stack_for(id).map(|s| &s.layers[..]).unwrap_or_default();
+            let layers: Vec<&Layer> =
+                look.stack_for(id).map(|s| s.layers.iter().filter(|l| l.enabled).collect()).unwrap_or_default();
             for (i, layer) in layers.iter().enumerate() {
                 // The bottom layer fills: its mask has no effect.
                 let mask = match &layer.mask {
@@ -113,7 +117,8 @@ impl PackedStacks {
                     pad: 0,
                 });
             }
-            // An object with neither its own stack nor a default one gets the default material.
+            // An object with neither its own stack nor a default one, or with every layer
+            // disabled, gets the default material.
             if layers.is_empty() {
                 packed.layers.push(GpuLayer::default_material());
             }
@@ -150,5 +155,56 @@ impl PackedStacks {
             params = params.mix(&Params::from_gpu(&layer.params), w);
         }
         params
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::look::ObjectStack;
+
+    fn layer(roughness: f32, mask: Option<&str>, enabled: bool) -> Layer {
+        Layer {
+            preset: None,
+            params: Params { roughness, ..Params::default() },
+            overrides: Vec::new(),
+            mask: mask.map(String::from),
+            invert: false,
+            opacity: 0.5,
+            enabled,
+            line: 0,
+        }
+    }
+
+    fn pack(layers: Vec<Layer>) -> PackedStacks {
+        let mut look = Look::default_material();
+        look.objects = vec![ObjectStack { id: Some(1), layers }];
+        PackedStacks::pack(&look, [1], &["stripes".to_string(), "grunge".to_string()], Path::new("test.exr")).unwrap()
+    }
+
+    #[test]
+    fn disabled_layers_are_left_out_and_the_lowest_enabled_layer_fills() {
+        // Bottom disabled: the striped layer becomes the bottom, so its mask no longer applies.
+        let packed =
+            pack(vec![layer(0.1, None, false), layer(0.2, Some("stripes"), true), layer(0.3, Some("grunge"), true)]);
+        assert_eq!(packed.stacks[0].layer_count, 2);
+        let roughness: Vec<f32> = packed.layers.iter().map(|l| Params::from_gpu(&l.params).roughness).collect();
+        assert_eq!(roughness, [0.2, 0.3]);
+        assert_eq!(packed.layers[0].mask, -1, "the filling layer's mask has no effect");
+        assert_eq!(packed.masks, ["grunge"], "a mask used only as the fill is not bound");
+        assert_eq!(packed.resolve_pixel(1, |_| 0.0).roughness, 0.2, "the new bottom fills where the mask is 0");
+
+        // A disabled layer in the middle simply drops out.
+        let packed =
+            pack(vec![layer(0.1, None, true), layer(0.2, Some("stripes"), false), layer(0.3, Some("grunge"), true)]);
+        let roughness: Vec<f32> = packed.layers.iter().map(|l| Params::from_gpu(&l.params).roughness).collect();
+        assert_eq!(roughness, [0.1, 0.3]);
+        assert_eq!(packed.masks, ["grunge"]);
+
+        // Every layer disabled: one layer of the default material.
+        let packed = pack(vec![layer(0.1, None, false), layer(0.2, Some("stripes"), false)]);
+        assert_eq!(packed.stacks[0].layer_count, 1);
+        assert_eq!(packed.layers, [GpuLayer::default_material()]);
+        assert_eq!(packed.resolve_pixel(1, |_| 1.0), Params::default());
     }
 }
