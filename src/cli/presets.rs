@@ -5,10 +5,10 @@ use super::progress::Progress;
 use crate::environment::{self, Environment};
 use crate::gbuffer::GBuffer;
 use crate::material::library::{self, Library, Origin};
-use crate::material::look::{Layer, Look, ObjectStack};
+use crate::material::look::{Layer, Look};
 use crate::material::params::{Param, Params};
 use crate::material::Preset;
-use crate::render::batch::Batch;
+use crate::render::batch::{preset_on_ball, Batch};
 use crate::render::settings::Settings;
 use crate::render::sheet::{self, Cell};
 use crate::{Error, Result};
@@ -204,27 +204,6 @@ fn layer_params(look_path: &Path, object: &str, layer: usize) -> Result<(Params,
     Ok((chosen.params, set))
 }
 
-/// The look of one contact-sheet cell: the preset on the ball, a neutral mid-grey pedestal.
-fn preset_on_ball(preset: &Preset) -> Look {
-    let layer = |params: Params| Layer {
-        preset: None,
-        params,
-        overrides: Vec::new(),
-        mask: None,
-        invert: false,
-        opacity: 1.0,
-        enabled: true,
-        line: 0,
-    };
-    let pedestal = Params { base_color: [0.18; 3], roughness: 0.6, ..Params::default() };
-    let mut look = Look::default_material();
-    look.objects = vec![
-        ObjectStack { id: None, layers: vec![layer(pedestal)] },
-        ObjectStack { id: Some(crate::gbuffer::BALL_ID), layers: vec![layer(preset.params)] },
-    ];
-    look
-}
-
 fn sheet(args: SheetArgs) -> Result<()> {
     if args.spp == 0 {
         return Err(Error::input("--spp 0: the sample count must be at least 1"));
@@ -252,7 +231,7 @@ fn sheet(args: SheetArgs) -> Result<()> {
         let mut progress = Progress::new(presets.len() as u64, "presets", args.quiet);
         let mut cells = Vec::new();
         for (i, (preset, origin)) in presets.iter().enumerate() {
-            batch.render(&preset_on_ball(preset), &settings, |_| {})?;
+            batch.render(&preset_on_ball(&preset.params), &settings, |_| {})?;
             let pixels = batch.display(&settings)?;
             let image = image::RgbaImage::from_raw(args.size, args.size, pixels).expect("size matches");
             let mut caption = preset.tags.join(", ");

@@ -184,7 +184,8 @@ impl Image {
                 "a {width}x{height} image is outside what this device supports (1 to {max} pixels a side)"
             )));
         }
-        let usage = vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
+        let usage =
+            vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
@@ -314,6 +315,25 @@ impl Image {
                 vk::ImageLayout::GENERAL,
                 staging.buffer,
                 &[self.copy_region()],
+            )
+        };
+    }
+
+    /// Records a copy of one texel of layer 0 into the start of `staging`.
+    pub fn record_read_texel(&self, cmd: vk::CommandBuffer, staging: &Buffer, x: u32, y: u32) {
+        let region = vk::BufferImageCopy::default()
+            .image_subresource(
+                vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(1),
+            )
+            .image_offset(vk::Offset3D { x: x as i32, y: y as i32, z: 0 })
+            .image_extent(vk::Extent3D { width: 1, height: 1, depth: 1 });
+        unsafe {
+            self.shared.device.cmd_copy_image_to_buffer(
+                cmd,
+                self.image,
+                vk::ImageLayout::GENERAL,
+                staging.buffer,
+                &[region],
             )
         };
     }

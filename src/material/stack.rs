@@ -2,7 +2,7 @@
 //! with their own materials, and the masks they use. `resolve.comp` blends them per pixel; the
 //! CPU [`PackedStacks::resolve_pixel`] mirrors it for tests and for inspecting pixels.
 
-use super::look::{Layer, Look};
+use super::look::{Layer, Look, ObjectStack};
 use super::params::Params;
 use crate::{Error, Result};
 use std::collections::BTreeMap;
@@ -47,6 +47,23 @@ fn check_masks(look: &Look, look_name: &str, available: &[String], gbuffer_name:
     Ok(())
 }
 
+/// Warnings for the look's stacks whose object id is not among `object_ids` (the g-buffer's
+/// shaded objects): those stacks can never show, which is usually a typo in the id.
+pub fn unused_stack_warnings(look: &Look, object_ids: &[u32], gbuffer_name: &Path) -> Vec<String> {
+    let look_name = look.file.as_deref().map(|p| p.display().to_string()).unwrap_or_else(|| "built-in look".into());
+    look.objects
+        .iter()
+        .filter_map(|stack| {
+            let id = stack.id.filter(|id| !object_ids.contains(id))?;
+            let line = stack.layers.first().map(|l| l.line).unwrap_or_default();
+            Some(format!(
+                "{look_name}:{line}: object id {id} is not in the g-buffer {}; its stack is unused",
+                gbuffer_name.display()
+            ))
+        })
+        .collect()
+}
+
 /// One stack as `resolve.comp` reads it: its first layer and how many layers it has.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
@@ -71,10 +88,9 @@ impl PackedStacks {
     /// Packs the look's stacks for the objects in `object_ids` (those that are shaded). Disabled
     /// layers are left out, so the lowest enabled layer is the one that fills. An object with
     /// neither its own stack nor a default stack, or whose layers are all disabled, gets the
-    /// default parameters. A mask the
-    /// look names that `available_masks` lacks is an error naming both files and the layer's
-    /// line; a stack for an id the g-buffer does not show is reported. Stack 0 always exists,
-    /// for the pixels that shade nothing.
+    /// default parameters. A mask the look names that `available_masks` lacks is an error
+    /// naming both files and the layer's line. Stack 0 always exists, for the pixels that shade
+    /// nothing.
     pub fn pack(
         look: &Look,
         object_ids: impl IntoIterator<Item = u32>,
@@ -83,16 +99,6 @@ impl PackedStacks {
     ) -> Result<PackedStacks> {
         let look_name = look.file.as_deref().map(|p| p.display().to_string()).unwrap_or_else(|| "built-in look".into());
         check_masks(look, &look_name, available_masks, gbuffer_name)?;
-        let object_ids: Vec<u32> = object_ids.into_iter().collect();
-        for stack in &look.objects {
-            if let Some(id) = stack.id.filter(|id| !object_ids.contains(id)) {
-                let line = stack.layers.first().map(|l| l.line).unwrap_or_default();
-                crate::warn(format!(
-                    "{look_name}:{line}: object id {id} is not in the g-buffer {}; its stack is unused",
-                    gbuffer_name.display()
-                ));
-            }
-        }
         let mut packed = PackedStacks {
             stacks: Vec::new(),
             layers: Vec::new(),
@@ -158,10 +164,43 @@ impl PackedStacks {
     }
 }
 
+/// How much one layer counts at a pixel, as `resolve.comp` blends the stack.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LayerWeight {
+    /// The layer's blend weight: 1 for the bottom (filling) layer, else opacity × mask value
+    /// (or 1 − mask value, inverted), clamped to [0, 1].
+    pub blend: f32,
+    /// The share of the result that is this layer's: its blend weight times what the layers
+    /// above it leave. The shares of a stack sum to 1.
+    pub contribution: f32,
+}
+
+/// Each layer's weight at a pixel whose mask values `mask_value` gives by name; `None` for a
+/// disabled layer. The same rule as [`PackedStacks::pack`] and `resolve.comp`: the lowest enabled
+/// layer fills, and each layer above mixes over the result of those below.
+pub fn layer_weights(stack: &ObjectStack, mask_value: impl Fn(&str) -> f32) -> Vec<Option<LayerWeight>> {
+    let mut weights: Vec<Option<LayerWeight>> = vec![None; stack.layers.len()];
+    let enabled: Vec<usize> = (0..stack.layers.len()).filter(|&i| stack.layers[i].enabled).collect();
+    let mut remaining = 1.0;
+    for (rank, &i) in enabled.iter().enumerate().rev() {
+        let layer = &stack.layers[i];
+        let blend = match &layer.mask {
+            _ if rank == 0 => 1.0,
+            Some(name) => {
+                let m = mask_value(name);
+                (layer.opacity * if layer.invert { 1.0 - m } else { m }).clamp(0.0, 1.0)
+            }
+            None => layer.opacity.clamp(0.0, 1.0),
+        };
+        weights[i] = Some(LayerWeight { blend, contribution: blend * remaining });
+        remaining *= 1.0 - blend;
+    }
+    weights
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::look::ObjectStack;
 
     fn layer(roughness: f32, mask: Option<&str>, enabled: bool) -> Layer {
         Layer {
@@ -206,5 +245,29 @@ mod tests {
         assert_eq!(packed.stacks[0].layer_count, 1);
         assert_eq!(packed.layers, [GpuLayer::default_material()]);
         assert_eq!(packed.resolve_pixel(1, |_| 1.0), Params::default());
+    }
+
+    #[test]
+    fn layer_weights_share_the_result_as_resolve_blends_it() {
+        let mut layers =
+            vec![layer(0.1, None, true), layer(0.5, Some("stripes"), true), layer(0.9, Some("grunge"), true)];
+        layers[2].invert = true;
+        layers.insert(1, layer(0.7, None, false));
+        let stack = ObjectStack { id: Some(1), layers: layers.clone() };
+        let masks = |name: &str| if name == "stripes" { 0.8 } else { 0.25 };
+        let weights = layer_weights(&stack, masks);
+        assert_eq!(weights[1], None, "a disabled layer has no weight");
+        let w: Vec<LayerWeight> = weights.iter().flatten().copied().collect();
+        assert_eq!(w[0].blend, 1.0, "the bottom layer fills");
+        assert!((w[1].blend - 0.5 * 0.8).abs() < 1e-6);
+        assert!((w[2].blend - 0.5 * 0.75).abs() < 1e-6, "inverted: opacity × (1 − mask)");
+        let total: f32 = w.iter().map(|w| w.contribution).sum();
+        assert!((total - 1.0).abs() < 1e-6, "shares sum to 1, got {total}");
+
+        let packed = pack(layers.clone());
+        let resolved = packed.resolve_pixel(1, |i| masks(&packed.masks[i])).roughness;
+        let enabled: Vec<&Layer> = layers.iter().filter(|l| l.enabled).collect();
+        let shared: f32 = enabled.iter().zip(&w).map(|(l, w)| l.params.roughness * w.contribution).sum();
+        assert!((resolved - shared).abs() < 1e-6, "resolve gives {resolved}, the shares {shared}");
     }
 }

@@ -8,8 +8,9 @@ use super::Renderer;
 use crate::environment::Environment;
 use crate::gbuffer::GBuffer;
 use crate::gpu::Context;
+use crate::material::look::{Layer, ObjectStack};
 use crate::material::stack::PackedStacks;
-use crate::material::Look;
+use crate::material::{Look, Params};
 use crate::Result;
 use std::path::Path;
 
@@ -59,4 +60,26 @@ impl<'a> Batch<'a> {
     pub fn radiance(&self) -> Result<Vec<[f32; 4]>> {
         self.renderer.read_radiance()
     }
+}
+
+/// The look of a preset's catalogue picture (a contact-sheet cell, a viewer thumbnail): the
+/// preset on the ball, a neutral mid-grey pedestal.
+pub fn preset_on_ball(params: &Params) -> Look {
+    let layer = |params: Params| Layer {
+        preset: None,
+        params,
+        overrides: Vec::new(),
+        mask: None,
+        invert: false,
+        opacity: 1.0,
+        enabled: true,
+        line: 0,
+    };
+    let pedestal = Params { base_color: [0.18; 3], roughness: 0.6, ..Params::default() };
+    let mut look = Look::default_material();
+    look.objects = vec![
+        ObjectStack { id: None, layers: vec![layer(pedestal)] },
+        ObjectStack { id: Some(crate::gbuffer::BALL_ID), layers: vec![layer(*params)] },
+    ];
+    look
 }

@@ -193,6 +193,20 @@ impl Renderer {
         self.row_samples.iter().copied().min().unwrap_or(0)
     }
 
+    /// Samples row `row` has in the current accumulation.
+    pub fn row_samples(&self, row: u32) -> u32 {
+        self.row_samples[row as usize]
+    }
+
+    /// The first run of rows with fewer samples than the most-sampled row, as (first row, rows):
+    /// what a band-by-band pass still has to do before every row has the same count.
+    pub fn lagging_rows(&self) -> Option<(u32, u32)> {
+        let most = *self.row_samples.iter().max()?;
+        let first = self.row_samples.iter().position(|&n| n < most)?;
+        let rows = self.row_samples[first..].iter().take_while(|&&n| n < most).count();
+        Some((first as u32, rows as u32))
+    }
+
     /// Changes the lighting; accumulation restarts if anything changed.
     pub fn set_lighting(&mut self, lighting: Lighting) {
         if lighting != self.lighting {
@@ -375,6 +389,19 @@ impl Renderer {
             Ok(())
         })?;
         Ok(bytemuck::cast_slice(&staging.bytes()[..self.radiance.byte_size() as usize]).to_vec())
+    }
+
+    /// The linear radiance of one pixel, as [`Renderer::read_radiance`] gives it. Its row's
+    /// display pixels are remade with `exposure` and `tonemap`, so what the viewer shows stays.
+    pub fn read_radiance_pixel(&self, x: u32, y: u32, exposure: f32, tonemap: Tonemap) -> Result<[f32; 4]> {
+        self.check_rendered()?;
+        let staging = Buffer::staging(&self.ctx, 16)?;
+        self.ctx.run(|cmd| {
+            self.record_finalize(cmd, y, 1, exposure, tonemap);
+            self.radiance.record_read_texel(cmd, &staging, x, y);
+            Ok(())
+        })?;
+        Ok(bytemuck::pod_read_unaligned(&staging.bytes()[..16]))
     }
 
     /// Display pixels: exposure, tone map and sRGB, as RGBA8; straight alpha (the coverage) when

@@ -3,7 +3,7 @@
 
 use crate::environment::{self, Environment, LoadOptions};
 use crate::gbuffer::GBuffer;
-use crate::material::stack::PackedStacks;
+use crate::material::stack::{unused_stack_warnings, PackedStacks};
 use crate::material::{Look, Param, Value};
 use crate::render::settings::{Overrides, Settings};
 use crate::Result;
@@ -33,7 +33,9 @@ impl Scene {
         settings: Settings,
     ) -> Result<Scene> {
         let available: Vec<String> = gbuffer.masks.keys().cloned().collect();
-        let stacks = PackedStacks::pack(&look, covered_object_ids(&gbuffer), &available, &gbuffer_name)?;
+        let covered = covered_object_ids(&gbuffer);
+        let stacks = PackedStacks::pack(&look, covered.iter().copied(), &available, &gbuffer_name)?;
+        unused_stack_warnings(&look, &covered, &gbuffer_name).into_iter().for_each(crate::warn);
         Ok(Scene { gbuffer, gbuffer_name, look, environment, settings, stacks })
     }
 

@@ -234,7 +234,7 @@ impl Document {
 
     /// Where the look's preset names and paths resolve: its folder, the user library, then the
     /// built-ins; without a file, the user library and the built-ins.
-    fn library(&self) -> Library {
+    pub fn library(&self) -> Library {
         match &self.path {
             Some(path) => Library::for_look(path),
             None => Library::standard(),
