@@ -2,8 +2,8 @@
 //!
 //! Data flows one way: files are read into validated Rust types ([`gbuffer`], [`environment`],
 //! [`material`]), uploaded to the GPU ([`gpu`]), relit by compute kernels ([`render`]) and written
-//! out as images. [`viewer_state`] is the document an interactive viewer edits, with undo and
-//! saving; it needs no GPU.
+//! out as images. [`viewer_state`] is the document the interactive viewer edits, with undo and
+//! saving; it needs no GPU. `viewer` (the default `viewer` feature) is the window around it.
 
 pub mod atomic_file;
 pub mod cli;
@@ -14,6 +14,8 @@ pub mod gpu;
 pub mod material;
 pub mod render;
 pub mod shading;
+#[cfg(feature = "viewer")]
+pub mod viewer;
 pub mod viewer_state;
 
 pub use error::{Error, ErrorKind, Result};

@@ -1,4 +1,4 @@
-//! The command line: `lookdev render | gbuffer | bench | devices`.
+//! The command line: `lookdev render | gbuffer | presets | wedge | turntable | view | lint | bench | devices`.
 
 mod bench;
 mod gbuffer;
@@ -8,6 +8,7 @@ mod presets;
 mod progress;
 mod render;
 mod turntable;
+mod view;
 mod wedge;
 
 use crate::gpu::ContextOptions;
@@ -35,6 +36,8 @@ pub enum Command {
     Wedge(wedge::WedgeArgs),
     /// Render the look with the environment turning through 360°, one image per frame.
     Turntable(turntable::TurntableArgs),
+    /// Open the interactive viewer: edit layer stacks and turn the light while it renders.
+    View(view::ViewArgs),
     /// Check a look's materials for implausible values.
     Lint(lint::LintArgs),
     /// Measure relighting throughput on the built-in scene.
@@ -70,6 +73,7 @@ pub fn run(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<()> {
         Command::Presets(args) => presets::run(args),
         Command::Wedge(args) => wedge::run(args),
         Command::Turntable(args) => turntable::run(args),
+        Command::View(args) => view::run(args),
         Command::Lint(args) => lint::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Devices => list_devices(),

@@ -64,8 +64,11 @@ impl Gui {
         self.release_view_texture();
         let device = &self.ctx.device;
         let layout = egui_ash_renderer::vulkan::create_vulkan_descriptor_set_layout(device).map_err(renderer_error)?;
-        let sizes = [vk::DescriptorPoolSize::default().ty(vk::DescriptorType::COMBINED_IMAGE_SAMPLER).descriptor_count(1)];
-        let pool = unsafe { device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None) }?;
+        let sizes =
+            [vk::DescriptorPoolSize::default().ty(vk::DescriptorType::COMBINED_IMAGE_SAMPLER).descriptor_count(1)];
+        let pool = unsafe {
+            device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None)
+        }?;
         // Nearest filtering: zoomed in, an artist inspects pixels, not a blur of them.
         let sampler_info = vk::SamplerCreateInfo::default()
             .mag_filter(vk::Filter::NEAREST)
@@ -76,7 +79,9 @@ impl Gui {
         let sampler = unsafe { device.create_sampler(&sampler_info, None) }?;
         let layouts = [layout];
         let set = unsafe {
-            device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts))
+            device.allocate_descriptor_sets(
+                &vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts),
+            )
         }?[0];
         let info = [vk::DescriptorImageInfo::default()
             .sampler(sampler)
@@ -105,22 +110,37 @@ impl Gui {
         }
     }
 
-    /// Runs the UI for one frame and draws it. Returns the captured window when `capture` is set
-    /// (see [`Presenter::frame`]).
-    pub fn frame(
-        &mut self,
-        window: &Window,
-        presenter: &mut Presenter,
-        capture: bool,
-        ui: impl FnMut(&egui::Context),
-    ) -> Result<Option<image::RgbaImage>> {
+    /// Runs the interface for one frame: input in, shapes out, nothing drawn yet.
+    pub fn run(&mut self, window: &Window, ui: impl FnMut(&mut egui::Ui)) -> egui::FullOutput {
         let input = self.state.take_egui_input(window);
-        let output = self.egui.run(input, ui);
-        self.state.handle_platform_output(window, output.platform_output);
+        let output = self.egui.run_ui(input, ui);
+        self.state.handle_platform_output(window, output.platform_output.clone());
+        output
+    }
+
+    /// How soon the interface wants another frame (animations, tooltips), if at all.
+    pub fn repaint_delay(output: &egui::FullOutput) -> Option<std::time::Duration> {
+        output
+            .viewport_output
+            .get(&egui::ViewportId::ROOT)
+            .map(|v| v.repaint_delay)
+            .filter(|d| *d != std::time::Duration::MAX)
+    }
+
+    /// Draws a frame's interface into the window. Returns the window's pixels when `capture` is
+    /// set (see [`Presenter::frame`]).
+    pub fn draw(
+        &mut self,
+        presenter: &mut Presenter,
+        output: egui::FullOutput,
+        capture: bool,
+    ) -> Result<Option<image::RgbaImage>> {
         let primitives = self.egui.tessellate(output.shapes, output.pixels_per_point);
-        for (id, delta) in &output.textures_delta.set {
-            let _queue = self.ctx.lock_queue();
-            self.renderer.set_texture(self.ctx.queue, presenter.pool(), *id, delta).map_err(renderer_error)?;
+        for (id, deltas) in &output.textures_delta.set {
+            for delta in deltas {
+                let _queue = self.ctx.lock_queue();
+                self.renderer.set_texture(self.ctx.queue, presenter.pool(), *id, delta).map_err(renderer_error)?;
+            }
         }
         let renderer = &mut self.renderer;
         let device = self.ctx.device.clone();

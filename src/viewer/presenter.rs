@@ -45,8 +45,9 @@ impl Presenter {
         let alloc = vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(1);
         let command_buffer = unsafe { device.allocate_command_buffers(&alloc) }?[0];
         let image_available = unsafe { device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }?;
-        let in_flight =
-            unsafe { device.create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None) }?;
+        let in_flight = unsafe {
+            device.create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None)
+        }?;
         let mut presenter = Presenter {
             ctx: ctx.clone(),
             surface_loader,
@@ -74,6 +75,11 @@ impl Presenter {
         self.pool
     }
 
+    /// Whether the window's images can be copied out, for screenshots.
+    pub fn capturable(&self) -> bool {
+        self.capturable
+    }
+
     /// Marks the swapchain for rebuilding at `width`×`height` before the next frame.
     pub fn resize(&mut self, width: u32, height: u32) {
         self.extent = vk::Extent2D { width, height };
@@ -81,7 +87,7 @@ impl Presenter {
     }
 
     fn rebuild(&mut self, width: u32, height: u32) -> Result<()> {
-        let device = &self.ctx.device;
+        let device = self.ctx.device.clone();
         unsafe { device.device_wait_idle() }?;
         let pd = self.ctx.physical_device;
         let caps = unsafe { self.surface_loader.get_physical_device_surface_capabilities(pd, self.surface) }?;
@@ -111,7 +117,8 @@ impl Presenter {
         } else {
             vk::ImageUsageFlags::COLOR_ATTACHMENT
         };
-        let count = (caps.min_image_count + 1).min(if caps.max_image_count > 0 { caps.max_image_count } else { u32::MAX });
+        let count =
+            (caps.min_image_count + 1).min(if caps.max_image_count > 0 { caps.max_image_count } else { u32::MAX });
         let old = self.swapchain;
         let info = vk::SwapchainCreateInfoKHR::default()
             .surface(self.surface)
@@ -206,13 +213,7 @@ impl Presenter {
                 &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
             )?;
             full_barrier(&device, cmd);
-            transition(
-                &device,
-                cmd,
-                image,
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-            );
+            transition(&device, cmd, image, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
         }
         record(cmd, view, extent)?;
         unsafe {
@@ -227,7 +228,9 @@ impl Presenter {
                     );
                     let region = vk::BufferImageCopy::default()
                         .image_subresource(
-                            vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(1),
+                            vk::ImageSubresourceLayers::default()
+                                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                                .layer_count(1),
                         )
                         .image_extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 });
                     device.cmd_copy_image_to_buffer(
@@ -238,7 +241,13 @@ impl Presenter {
                         &[region],
                     );
                     full_barrier(&device, cmd);
-                    transition(&device, cmd, image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::PRESENT_SRC_KHR);
+                    transition(
+                        &device,
+                        cmd,
+                        image,
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                        vk::ImageLayout::PRESENT_SRC_KHR,
+                    );
                 }
                 None => transition(
                     &device,
@@ -266,14 +275,18 @@ impl Presenter {
         let stages = [vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT | vk::PipelineStageFlags::TRANSFER];
         let signals = [self.render_finished[index as usize]];
         let cmds = [cmd];
-        let submit =
-            vk::SubmitInfo::default().wait_semaphores(&waits).wait_dst_stage_mask(&stages).command_buffers(&cmds).signal_semaphores(&signals);
+        let submit = vk::SubmitInfo::default()
+            .wait_semaphores(&waits)
+            .wait_dst_stage_mask(&stages)
+            .command_buffers(&cmds)
+            .signal_semaphores(&signals);
         let presented = {
             let _queue = self.ctx.lock_queue();
             unsafe { device.queue_submit(self.ctx.queue, &[submit], self.in_flight) }?;
             let swapchains = [self.swapchain];
             let indices = [index];
-            let present = vk::PresentInfoKHR::default().wait_semaphores(&signals).swapchains(&swapchains).image_indices(&indices);
+            let present =
+                vk::PresentInfoKHR::default().wait_semaphores(&signals).swapchains(&swapchains).image_indices(&indices);
             unsafe { self.swapchain_loader.queue_present(self.ctx.queue, &present) }
         };
         match presented {
@@ -298,7 +311,13 @@ fn color_range() -> vk::ImageSubresourceRange {
     vk::ImageSubresourceRange::default().aspect_mask(vk::ImageAspectFlags::COLOR).level_count(1).layer_count(1)
 }
 
-fn transition(device: &ash::Device, cmd: vk::CommandBuffer, image: vk::Image, from: vk::ImageLayout, to: vk::ImageLayout) {
+fn transition(
+    device: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: vk::Image,
+    from: vk::ImageLayout,
+    to: vk::ImageLayout,
+) {
     let barrier = vk::ImageMemoryBarrier::default()
         .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
         .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE)
@@ -323,7 +342,7 @@ fn transition(device: &ash::Device, cmd: vk::CommandBuffer, image: vk::Image, fr
 
 impl Drop for Presenter {
     fn drop(&mut self) {
-        let device = &self.ctx.device;
+        let device = self.ctx.device.clone();
         unsafe {
             let _ = device.device_wait_idle();
             self.destroy_swapchain_parts();

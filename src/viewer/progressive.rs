@@ -1,6 +1,6 @@
-//! Progressive rendering bounded per frame: each frame relights a band of rows with one sample,
-//! sized so the frame stays responsive; a full pass is done when the band has swept the image.
-//! On a fast device a band is the whole image, so a change shows within one frame.
+//! Progressive rendering bounded per frame: each frame relights a band of rows, sized from the
+//! measured speed so the frame stays responsive; a pass is done when the bands have swept the
+//! image. On a fast device a band is the whole image, so a change shows within one frame.
 
 use crate::render::tonemap::Tonemap;
 use crate::render::Renderer;
@@ -11,11 +11,13 @@ use std::time::{Duration, Instant};
 const FRAME_BUDGET: Duration = Duration::from_millis(25);
 /// The smallest band, so a slow device still makes progress each frame.
 const MIN_BAND_ROWS: u32 = 8;
+/// Samples per band once the first pass has landed: fewer, longer dispatches amortise each
+/// pass's per-pixel set-up, which on a CPU driver costs about as much as a sample.
+const SAMPLES_PER_BAND: u32 = 4;
 
 /// Where the sweep is, how fast rows relight, and the figures the status bar shows.
 pub struct Progressive {
     cursor: u32,
-    band_rows: u32,
     /// Seconds to relight one row with one sample (a running average).
     row_seconds: f64,
     /// When the current accumulation started, and when its first full pass landed.
@@ -27,10 +29,9 @@ pub struct Progressive {
 }
 
 impl Progressive {
-    pub fn new(height: u32) -> Progressive {
+    pub fn new() -> Progressive {
         Progressive {
             cursor: 0,
-            band_rows: height.max(1),
             row_seconds: 0.0,
             started: Instant::now(),
             first_pass: None,
@@ -49,22 +50,36 @@ impl Progressive {
     }
 
     /// Relights the next band if the image has fewer than `target` samples, then makes its
-    /// display pixels. Returns whether anything was rendered.
+    /// display pixels. The first pass after a change takes one sample per band, so the whole
+    /// image changes soonest; later bands take a few. Returns whether anything was rendered.
     pub fn step(&mut self, renderer: &mut Renderer, target: u32, exposure: f32, tonemap: Tonemap) -> Result<bool> {
         if renderer.samples() >= target {
             return Ok(false);
         }
         let height = renderer.height;
-        let rows = self.band_rows.clamp(MIN_BAND_ROWS.min(height), height - self.cursor);
+        if renderer.row_samples(self.cursor) >= target {
+            // The rows from here on are done (a completed pass caught them up): start over.
+            self.cursor = 0;
+        }
+        let count = match self.first_pass {
+            None => 1,
+            Some(_) => SAMPLES_PER_BAND.min(target - renderer.row_samples(self.cursor)),
+        };
+        let wanted = if self.row_seconds > 0.0 {
+            (FRAME_BUDGET.as_secs_f64() / (self.row_seconds * count as f64)) as u32
+        } else {
+            MIN_BAND_ROWS // the first band measures the device
+        };
+        let rows = wanted.max(MIN_BAND_ROWS).min(height - self.cursor);
         let start = Instant::now();
-        renderer.render_rows(self.cursor, rows, 1)?;
+        renderer.render_rows(self.cursor, rows, count)?;
         renderer.finalize_rows(self.cursor, rows, exposure, tonemap)?;
         let elapsed = start.elapsed();
         self.busy += elapsed;
-        self.pixel_samples += rows as f64 * renderer.width as f64;
-        let per_row = elapsed.as_secs_f64() / rows as f64;
+        let row_samples = rows as f64 * count as f64;
+        self.pixel_samples += row_samples * renderer.width as f64;
+        let per_row = elapsed.as_secs_f64() / row_samples;
         self.row_seconds = if self.row_seconds == 0.0 { per_row } else { 0.7 * self.row_seconds + 0.3 * per_row };
-        self.band_rows = ((FRAME_BUDGET.as_secs_f64() / self.row_seconds.max(1e-9)) as u32).clamp(MIN_BAND_ROWS, height);
         self.cursor += rows;
         if self.cursor >= height {
             self.cursor = 0;

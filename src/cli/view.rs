@@ -1,0 +1,101 @@
+//! `lookdev view`: the interactive viewer.
+
+use super::inputs::{self, DisplayArgs, LightingArgs, SamplingArgs};
+use crate::{Error, Result};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct ViewArgs {
+    /// The look to open (default: the built-in default look on the built-in shader ball, or the
+    /// default material on a g-buffer).
+    #[arg(value_name = "LOOK.toml")]
+    pub look: Option<PathBuf>,
+    /// The g-buffer EXR to relight (default: the built-in shader ball, 1024x1024).
+    #[arg(long, value_name = "FILE.exr")]
+    pub gbuffer: Option<PathBuf>,
+    /// Override a parameter on every layer of every object when the look opens.
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+    #[command(flatten)]
+    pub lighting: LightingArgs,
+    #[command(flatten)]
+    pub sampling: SamplingArgs,
+    #[command(flatten)]
+    pub display: DisplayArgs,
+    /// Vulkan device to use: part of its name (lavapipe is "llvmpipe").
+    #[arg(long, value_name = "NAME")]
+    pub device: Option<String>,
+    /// The window's size in logical pixels.
+    #[arg(long, num_args = 2, value_names = ["W", "H"])]
+    pub window_size: Option<Vec<u32>>,
+    /// Save the window as a PNG once --exit-after-spp is reached.
+    #[arg(long, value_name = "FILE.png", requires = "exit_after_spp")]
+    pub screenshot: Option<PathBuf>,
+    /// Render until every pixel has N samples (after the script, if any), then exit. N becomes
+    /// the target spp.
+    #[arg(long, value_name = "N")]
+    pub exit_after_spp: Option<u32>,
+    /// Run interface actions from a file, one per line (see the README).
+    #[arg(long, value_name = "FILE")]
+    pub script: Option<PathBuf>,
+}
+
+pub fn run(args: ViewArgs) -> Result<()> {
+    if args.exit_after_spp == Some(0) {
+        return Err(Error::input("--exit-after-spp 0: the sample count must be at least 1"));
+    }
+    if let Some(path) = &args.screenshot {
+        crate::render::output::OutputFormat::from_path(path)
+            .ok()
+            .filter(|f| *f == crate::render::output::OutputFormat::Png)
+            .ok_or_else(|| Error::input_file(path, "a screenshot is a .png file"))?;
+    }
+    let window_size = match args.window_size.as_deref() {
+        None => DEFAULT_WINDOW_SIZE,
+        Some(&[w, h]) if (320..=16384).contains(&w) && (240..=16384).contains(&h) => (w, h),
+        Some(size) => {
+            return Err(Error::input(format!("--window-size {size:?}: the window must be 320x240 to 16384x16384")));
+        }
+    };
+    let sets = inputs::parse_sets(&args.set)?;
+    let overrides = inputs::overrides(&args.lighting, &args.sampling, &args.display);
+    open(args, sets, overrides, window_size)
+}
+
+#[cfg(feature = "viewer")]
+const DEFAULT_WINDOW_SIZE: (u32, u32) = crate::viewer::DEFAULT_WINDOW_SIZE;
+#[cfg(not(feature = "viewer"))]
+const DEFAULT_WINDOW_SIZE: (u32, u32) = (1600, 960);
+
+#[cfg(feature = "viewer")]
+fn open(
+    args: ViewArgs,
+    sets: Vec<(crate::material::Param, crate::material::Value)>,
+    overrides: crate::render::settings::Overrides,
+    window_size: (u32, u32),
+) -> Result<()> {
+    let script = args.script.as_deref().map(crate::viewer::Script::load).transpose()?;
+    crate::viewer::run(crate::viewer::ViewOptions {
+        env_options: args.lighting.load_options(),
+        look: args.look,
+        gbuffer: args.gbuffer,
+        sets,
+        overrides,
+        device: args.device,
+        window_size,
+        screenshot: args.screenshot,
+        exit_after_spp: args.exit_after_spp,
+        script,
+    })
+}
+
+#[cfg(not(feature = "viewer"))]
+fn open(
+    _args: ViewArgs,
+    _sets: Vec<(crate::material::Param, crate::material::Value)>,
+    _overrides: crate::render::settings::Overrides,
+    _window_size: (u32, u32),
+) -> Result<()> {
+    Err(Error::input("this lookdev was built without the viewer: rebuild with the default `viewer` feature"))
+}

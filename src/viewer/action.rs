@@ -1,0 +1,61 @@
+//! Everything the artist can do in the viewer, as data. The panels produce actions and the
+//! script reads them from a file; both are carried out by the same code, so a scripted test
+//! drives the real interface.
+
+use crate::viewer_state::{Edit, Selection};
+use std::path::PathBuf;
+
+/// One thing the artist did.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Action {
+    /// A change to the document, its own undo step.
+    Edit(Edit),
+    /// A change made while dragging a continuous control: it joins the drag's undo step.
+    Drag(Edit),
+    /// The drag is over; the next change starts a new undo step.
+    EndGesture,
+    Undo,
+    Redo,
+    Select(Selection),
+    /// Adds a layer of the named preset on top of the selected stack and selects it.
+    AddPresetLayer(String),
+    /// Sets the mask of the selected layer, after checking that the g-buffer has it.
+    SetMask(Option<String>),
+    /// A click on image pixel (x, y): select the object there and inspect the pixel.
+    Pick {
+        x: u32,
+        y: u32,
+    },
+    /// Loads an environment (`None`: the built-in studio) and makes it the look's.
+    OpenEnvironment(Option<PathBuf>),
+    /// Opens another look (asks first when there are unsaved edits).
+    OpenLook(PathBuf),
+    /// Saves the look, to its own file when `None`.
+    SaveLook(Option<PathBuf>),
+    /// Saves the selected layer to the user library.
+    SaveLayerAsPreset {
+        name: String,
+        description: String,
+        tags: Vec<String>,
+        force: bool,
+    },
+    /// Saves the current render, as `lookdev render` would: PNG display pixels or EXR radiance.
+    SaveImage(PathBuf),
+    /// Saves the window's contents as a PNG.
+    Screenshot(PathBuf),
+    /// Closes the viewer (asks first when there are unsaved edits).
+    Quit,
+    /// The answer to the unsaved-edits question.
+    Answer(Answer),
+}
+
+/// What to do with unsaved edits before they would be lost.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Answer {
+    /// Save the look, then go on.
+    Save,
+    /// Drop the edits and go on.
+    Discard,
+    /// Stay, edits kept.
+    Cancel,
+}

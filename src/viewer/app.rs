@@ -1,0 +1,589 @@
+//! The window and its frames. A frame takes one script step, runs the interface, carries out
+//! the actions it produced, hands the renderer what changed, relights one band, and presents.
+//! Carrying out the actions before relighting means an edit's first band is in the very frame
+//! that made it.
+
+use super::action::{Action, Answer};
+use super::gui::Gui;
+use super::presenter::Presenter;
+use super::script::{ScriptRunner, Step};
+use super::session::Session;
+use super::thumbnails::{self, Thumbnails};
+use super::ui::{FileDialog, FilePurpose, Frame, FrameFigures, Interface, Pending};
+use super::ViewOptions;
+use crate::environment::{self, Environment};
+use crate::gbuffer::GBuffer;
+use crate::gpu::context::{Presentation, ValidationCounter};
+use crate::gpu::{Context, ContextOptions};
+use crate::material::stack::{unused_stack_warnings, PackedStacks};
+use crate::material::Look;
+use crate::render::scene::{covered_object_ids, BUILTIN_SIZE};
+use crate::render::settings::{Overrides, Settings};
+use crate::viewer_state::{Document, Edit, ObjectRef, Selection};
+use crate::{Error, Result};
+use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+use winit::application::ApplicationHandler;
+use winit::event::WindowEvent;
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::window::{Window, WindowId};
+
+/// Opens the window and runs until it closes.
+pub fn run(options: ViewOptions) -> Result<()> {
+    // Everything that can be wrong with the input is found before a window opens.
+    let inputs = Inputs::load(&options)?;
+    let event_loop = EventLoop::new().map_err(super::no_display)?;
+    let mut app = App { options, inputs: Some(inputs), running: None, outcome: Ok(()), validation: None };
+    let ran = event_loop.run_app(&mut app);
+    // The GPU objects go before the validation count is read: leaks are reported on destruction.
+    app.running = None;
+    ran.map_err(|e| Error::gpu(format!("the window system failed ({e})")))?;
+    app.outcome?;
+    match app.validation.map_or(0, |counter| counter.errors()) {
+        0 => Ok(()),
+        n => Err(Error::gpu(format!("Vulkan validation reported {n} error(s); see above"))),
+    }
+}
+
+/// The files read and checked before the window opens.
+struct Inputs {
+    gbuffer: GBuffer,
+    gbuffer_name: PathBuf,
+    document: Document,
+    environment: Environment,
+}
+
+impl Inputs {
+    fn load(options: &ViewOptions) -> Result<Inputs> {
+        let mut look = match &options.look {
+            Some(path) => Look::load(path)?,
+            None if options.gbuffer.is_none() => Look::builtin_default(),
+            None => Look::default_material(),
+        };
+        for (param, value) in &options.sets {
+            look.set_everywhere(*param, *value).map_err(Error::input)?;
+        }
+        let settings = Settings::resolve(&look, &options.overrides)?;
+        let (gbuffer, gbuffer_name) = match &options.gbuffer {
+            Some(path) => (GBuffer::read(path)?, path.clone()),
+            None => (GBuffer::shaderball(BUILTIN_SIZE, BUILTIN_SIZE), PathBuf::from("built-in shader ball")),
+        };
+        let environment = match &settings.environment {
+            Some(path) => environment::load::load(path, &options.env_options)?,
+            None => Environment::studio(),
+        };
+        let covered = covered_object_ids(&gbuffer);
+        let masks: Vec<String> = gbuffer.masks.keys().cloned().collect();
+        PackedStacks::pack(&look, covered.iter().copied(), &masks, &gbuffer_name)?;
+        unused_stack_warnings(&look, &covered, &gbuffer_name).into_iter().for_each(crate::warn);
+        let mut document = Document::new(look, options.look.clone(), settings);
+        document.select(initial_selection(&document, &covered));
+        Ok(Inputs { gbuffer, gbuffer_name, document, environment })
+    }
+}
+
+/// The first shaded object with a stack of its own and its top layer, else the default stack.
+fn initial_selection(document: &Document, covered: &[u32]) -> Selection {
+    let look = document.look();
+    let object = covered
+        .iter()
+        .find(|id| look.objects.iter().any(|o| o.id == Some(**id)))
+        .map_or(ObjectRef::Default, |id| ObjectRef::Id(*id));
+    let top = document.stack(object).map(|s| s.layers.len().saturating_sub(1));
+    Selection { object: Some(object), layer: top }
+}
+
+struct App {
+    options: ViewOptions,
+    inputs: Option<Inputs>,
+    running: Option<Running>,
+    outcome: Result<()>,
+    validation: Option<Arc<ValidationCounter>>,
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(inputs) = self.inputs.take() else { return };
+        match Running::start(event_loop, &self.options, inputs) {
+            Ok(running) => {
+                self.validation = Some(running.ctx.validation_counter());
+                self.running = Some(running);
+            }
+            Err(e) => {
+                self.outcome = Err(e);
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _window: WindowId, event: WindowEvent) {
+        let Some(running) = &mut self.running else { return };
+        match running.window_event(event) {
+            Ok(true) => {}
+            Ok(false) => event_loop.exit(),
+            Err(e) => {
+                self.outcome = Err(e);
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        if let Some(running) = &mut self.running {
+            event_loop.set_control_flow(running.schedule());
+        }
+    }
+}
+
+/// Where an action came from: the panels, whose failures are shown, or a script line, whose
+/// failures stop the viewer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Origin {
+    Interface,
+    Script(usize),
+}
+
+/// The open window and everything drawn in it. Fields drop in order: the interface's GPU parts
+/// before the context they were made from, the window after its surface.
+struct Running {
+    gui: Gui,
+    presenter: Presenter,
+    thumbnails: Thumbnails,
+    session: Session,
+    ctx: Context,
+    window: Window,
+    interface: Interface,
+    script: Option<ScriptRunner>,
+    queue: Vec<(Origin, Action)>,
+    pending: Option<Pending>,
+    screenshots: Vec<PathBuf>,
+    exit_after_spp: Option<u32>,
+    final_screenshot: Option<PathBuf>,
+    clock: FrameClock,
+    title: String,
+    next_repaint: Option<Instant>,
+    quit: bool,
+}
+
+impl Running {
+    fn start(event_loop: &ActiveEventLoop, options: &ViewOptions, inputs: Inputs) -> Result<Running> {
+        let (width, height) = options.window_size;
+        let attributes = Window::default_attributes()
+            .with_title("lookdev")
+            .with_inner_size(winit::dpi::LogicalSize::new(width, height));
+        let window = event_loop.create_window(attributes).map_err(super::no_display)?;
+        let handle_error = |e: raw_window_handle::HandleError| Error::gpu(format!("the window has no handle ({e})"));
+        let display = window.display_handle().map_err(handle_error)?.as_raw();
+        let window_handle = window.window_handle().map_err(handle_error)?.as_raw();
+        let extensions = ash_window::enumerate_required_extensions(display)
+            .map_err(|e| Error::gpu(format!("this window system cannot show Vulkan images ({e})")))?;
+        let create_surface = |entry: &ash::Entry, instance: &ash::Instance| {
+            unsafe { ash_window::create_surface(entry, instance, display, window_handle, None) }
+                .map_err(|e| Error::gpu(format!("cannot draw into the window ({e})")))
+        };
+        let presentation = Presentation { instance_extensions: extensions, create_surface: &create_surface };
+        let (ctx, surface) = Context::with_surface(&ContextOptions::from_env(options.device.clone()), presentation)?;
+        let size = window.inner_size();
+        let presenter = Presenter::new(&ctx, surface, size.width, size.height)?;
+        let gui = Gui::new(&ctx, &window, &presenter)?;
+        let thumbnails = Thumbnails::new(&ctx, thumbnails::cache_dir())?;
+        let max = ctx.info().max_image_dimension_2d;
+        if inputs.gbuffer.width > max || inputs.gbuffer.height > max {
+            return Err(Error::input_file(
+                &inputs.gbuffer_name,
+                format!("the g-buffer is larger than {}'s {max}-pixel image limit", ctx.info().name),
+            ));
+        }
+        let mut session = Session::new(
+            &ctx,
+            inputs.gbuffer,
+            inputs.gbuffer_name,
+            inputs.document,
+            inputs.environment,
+            options.env_options,
+        )?;
+        if let Some(spp) = options.exit_after_spp {
+            session.override_target(spp);
+        }
+        let mut running = Running {
+            gui,
+            presenter,
+            thumbnails,
+            session,
+            ctx,
+            window,
+            interface: Interface::default(),
+            script: options.script.clone().map(ScriptRunner::new),
+            queue: Vec::new(),
+            pending: None,
+            screenshots: Vec::new(),
+            exit_after_spp: options.exit_after_spp,
+            final_screenshot: options.screenshot.clone(),
+            clock: FrameClock::default(),
+            title: String::new(),
+            next_repaint: None,
+            quit: false,
+        };
+        running.update_title();
+        running.window.request_redraw();
+        Ok(running)
+    }
+
+    /// Handles one window event. Returns false when the viewer should close.
+    fn window_event(&mut self, event: WindowEvent) -> Result<bool> {
+        match &event {
+            WindowEvent::RedrawRequested => {
+                self.redraw()?;
+                return Ok(!self.quit);
+            }
+            WindowEvent::CloseRequested => self.queue.push((Origin::Interface, Action::Quit)),
+            WindowEvent::Resized(size) => self.presenter.resize(size.width, size.height),
+            _ => {}
+        }
+        self.gui.on_event(&self.window, &event);
+        self.window.request_redraw();
+        Ok(true)
+    }
+
+    /// How the event loop should wait: not at all while rendering or scripted, else until the
+    /// interface next wants a frame or an event comes.
+    fn schedule(&mut self) -> ControlFlow {
+        let busy = self.session.samples() < self.session.target()
+            || self.script.as_ref().is_some_and(|s| !s.finished())
+            || self.exit_after_spp.is_some()
+            || !self.queue.is_empty()
+            || !self.screenshots.is_empty();
+        match self.next_repaint {
+            _ if busy => {
+                self.window.request_redraw();
+                ControlFlow::Poll
+            }
+            Some(at) if at <= Instant::now() => {
+                self.window.request_redraw();
+                ControlFlow::Poll
+            }
+            Some(at) => ControlFlow::WaitUntil(at),
+            None => ControlFlow::Wait,
+        }
+    }
+
+    fn redraw(&mut self) -> Result<()> {
+        let started = Instant::now();
+        let finishing = self.headless_done();
+        if !finishing {
+            self.script_step()?;
+        }
+        let view_texture = self.gui.view_texture(self.session.display_image())?;
+        let mut actions = Vec::new();
+        let frame = Frame {
+            session: &self.session,
+            view_texture,
+            pending: self.pending.as_ref(),
+            figures: FrameFigures { frame: self.clock.recent_mean() },
+        };
+        let output =
+            self.gui.run(&self.window, |ui| self.interface.show(ui, &frame, &mut self.thumbnails, &mut actions));
+        self.next_repaint = Gui::repaint_delay(&output).map(|delay| Instant::now() + delay);
+        self.queue.extend(actions.into_iter().map(|action| (Origin::Interface, action)));
+        for (origin, action) in std::mem::take(&mut self.queue) {
+            self.perform(origin, action)?;
+        }
+        if let Err(e) = self.session.sync() {
+            // Keep the renderer and the document in agreement: take the change back.
+            self.session.document.undo();
+            self.session.sync()?;
+            self.interface.tell(format!("{e}; the change was undone"), true);
+        }
+        if !finishing {
+            self.session.step()?;
+        }
+        self.update_title();
+        let capture = finishing || !self.screenshots.is_empty();
+        let captured = self.gui.draw(&mut self.presenter, output, capture)?;
+        if capture {
+            self.save_screenshots(captured, finishing)?;
+        }
+        self.clock.record(started.elapsed(), self.session.samples() < self.session.target());
+        Ok(())
+    }
+
+    /// With `--exit-after-spp`: the script (if any) is done and the image has its samples.
+    fn headless_done(&self) -> bool {
+        let Some(spp) = self.exit_after_spp else { return false };
+        self.script.as_ref().is_none_or(|s| s.finished())
+            && self.pending.is_none()
+            && self.queue.is_empty()
+            && self.session.samples() >= spp
+            && self.clock.frames >= 3
+    }
+
+    /// Queues the script's next action, unless it is waiting for samples.
+    fn script_step(&mut self) -> Result<()> {
+        let Some(runner) = &mut self.script else { return Ok(()) };
+        let Some((line, step)) = runner.next(self.session.samples(), self.session.target())? else {
+            return Ok(());
+        };
+        let action = match step {
+            Step::Do(action) => action,
+            Step::Layer(change) => {
+                let (object, layer) = selected_layer(&self.session.document).map_err(|e| runner.error_at(line, e))?;
+                Action::Edit(change.edit(object, layer))
+            }
+            Step::WaitSpp(_) => return Ok(()),
+        };
+        self.queue.push((Origin::Script(line), action));
+        Ok(())
+    }
+
+    /// Carries out an action. A failure from the panels is shown in the status bar; one from a
+    /// script line stops the viewer, naming the line.
+    fn perform(&mut self, origin: Origin, action: Action) -> Result<()> {
+        let scripted_pick = matches!((origin, &action), (Origin::Script(_), Action::Pick { .. }));
+        let outcome = self.try_perform(action);
+        if let (true, Ok(_), Some(pixel)) = (scripted_pick, &outcome, &self.session.inspection) {
+            println!("lookdev: {pixel}");
+        }
+        match (outcome, origin) {
+            (Ok(Some(note)), _) => self.interface.tell(note, false),
+            (Ok(None), _) => {}
+            (Err(e), Origin::Interface) => self.interface.tell(e.to_string(), true),
+            (Err(e), Origin::Script(line)) => {
+                let runner = self.script.as_ref().expect("a script line came from the script");
+                return Err(runner.error_at(line, e));
+            }
+        }
+        Ok(())
+    }
+
+    fn try_perform(&mut self, action: Action) -> Result<Option<String>> {
+        let document = &mut self.session.document;
+        match action {
+            Action::Edit(edit) => document.apply(edit).map_err(Error::input)?,
+            Action::Drag(edit) => document.apply_merging(edit).map_err(Error::input)?,
+            Action::EndGesture => document.end_gesture(),
+            Action::Undo => {
+                if !document.undo() {
+                    return Ok(Some("nothing to undo".into()));
+                }
+            }
+            Action::Redo => {
+                if !document.redo() {
+                    return Ok(Some("nothing to redo".into()));
+                }
+            }
+            Action::Select(selection) => document.select(selection),
+            Action::AddPresetLayer(preset) => {
+                let object = document.selection().object.unwrap_or(ObjectRef::Default);
+                document.apply(Edit::AddLayer { object, preset: preset.clone() }).map_err(Error::input)?;
+                let top = document.stack(object).map(|s| s.layers.len() - 1);
+                document.select(Selection { object: Some(object), layer: top });
+                return Ok(Some(format!("added {preset} on top of {object}")));
+            }
+            Action::SetMask(mask) => {
+                if let Some(name) = mask.as_ref().filter(|m| !self.session.masks().contains(m)) {
+                    let has = self.session.masks().join(", ");
+                    return Err(Error::input(format!("the g-buffer has no mask '{name}' (it has: {has})")));
+                }
+                let document = &mut self.session.document;
+                let (object, layer) = selected_layer(document)?;
+                document.apply(Edit::SetMask { object, layer, mask }).map_err(Error::input)?;
+            }
+            Action::Pick { x, y } => {
+                let pixel = self.session.inspect(x, y)?;
+                if pixel.coverage > 0.0 {
+                    let object = ObjectRef::Id(pixel.object_id);
+                    let document = &mut self.session.document;
+                    let top = document.stack(object).map(|s| s.layers.len().saturating_sub(1));
+                    document.select(Selection { object: Some(object), layer: top });
+                }
+            }
+            Action::OpenEnvironment(path) => {
+                self.session.load_environment(path.as_deref())?;
+                self.session.document.apply(Edit::SetEnvironment(path)).map_err(Error::input)?;
+            }
+            Action::OpenLook(path) => {
+                if document.is_dirty() {
+                    self.pending = Some(Pending::Open(path));
+                } else {
+                    return self.open_look(&path);
+                }
+            }
+            Action::SaveLook(path) => {
+                let written = document.save(path.as_deref())?;
+                return Ok(Some(format!("saved {}", written.display())));
+            }
+            Action::SaveLayerAsPreset { name, description, tags, force } => {
+                let (object, layer) = selected_layer(document)?;
+                let written = document.save_layer_as_preset(object, layer, &name, &description, &tags, force)?;
+                self.interface.refresh_library();
+                return Ok(Some(format!("saved preset {name} to {}", written.display())));
+            }
+            Action::SaveImage(path) => {
+                let spp = self.session.save_image(&path)?;
+                return Ok(Some(format!("saved {} ({spp} spp)", path.display())));
+            }
+            Action::Screenshot(path) => self.screenshots.push(path),
+            Action::Quit => {
+                if document.is_dirty() {
+                    self.pending = Some(Pending::Quit);
+                } else {
+                    self.quit = true;
+                }
+            }
+            Action::Answer(answer) => {
+                let pending = self.pending.take().ok_or_else(|| Error::input("there is no question to answer"))?;
+                match answer {
+                    Answer::Cancel => {}
+                    Answer::Discard => return self.proceed(pending),
+                    Answer::Save if document.path().is_none() => {
+                        self.pending = Some(pending);
+                        self.interface.file_dialog = Some(FileDialog::new(FilePurpose::SaveLook));
+                        return Err(Error::input("the look has no file yet: choose where to save it"));
+                    }
+                    Answer::Save => {
+                        document.save(None)?;
+                        return self.proceed(pending);
+                    }
+                }
+            }
+        }
+        Ok(None)
+    }
+
+    /// Does what the unsaved-edits question held back.
+    fn proceed(&mut self, pending: Pending) -> Result<Option<String>> {
+        match pending {
+            Pending::Quit => {
+                self.quit = true;
+                Ok(None)
+            }
+            Pending::Open(path) => self.open_look(&path),
+        }
+    }
+
+    fn open_look(&mut self, path: &Path) -> Result<Option<String>> {
+        let look = Look::load(path)?;
+        let settings = Settings::resolve(&look, &Overrides::default())?;
+        let warnings = unused_stack_warnings(&look, self.session.objects(), &self.session.gbuffer_name);
+        let mut document = Document::new(look, Some(path.to_path_buf()), settings);
+        document.select(initial_selection(&document, self.session.objects()));
+        self.session.replace_document(document)?;
+        warnings.into_iter().for_each(crate::warn);
+        Ok(Some(format!("opened {}", path.display())))
+    }
+
+    fn save_screenshots(&mut self, captured: Option<image::RgbaImage>, finishing: bool) -> Result<()> {
+        let Some(image) = captured else {
+            if !self.presenter.capturable() {
+                return Err(Error::gpu(format!(
+                    "{} cannot copy the window's images, so no screenshot can be taken",
+                    self.session.device_name()
+                )));
+            }
+            return Ok(()); // the frame was skipped (resized, minimised): try the next one
+        };
+        let mut paths = std::mem::take(&mut self.screenshots);
+        if finishing {
+            paths.extend(self.final_screenshot.take());
+        }
+        for path in &paths {
+            crate::render::output::write_png_image(path, &image)?;
+            let placement = self.interface.placement.map_or(String::new(), |p| {
+                format!("; the image is at {},{} size {}x{} scale {}", p.x, p.y, p.width, p.height, p.scale)
+            });
+            println!(
+                "lookdev: screenshot {} ({}x{} window, {} spp{placement})",
+                path.display(),
+                image.width(),
+                image.height(),
+                self.session.samples()
+            );
+        }
+        if finishing {
+            eprintln!("lookdev: {}", self.report());
+            self.quit = true;
+        }
+        Ok(())
+    }
+
+    /// The figures a headless run ends with.
+    fn report(&self) -> String {
+        let session = &self.session;
+        let first =
+            session.first_pass_after_change.map_or("n/a".to_string(), |d| format!("{:.0} ms", d.as_secs_f64() * 1e3));
+        format!(
+            "viewer: {}x{} on {}: {} spp; frame time while rendering {}; first full pass after the last change {first}; {:.1} M samples/s",
+            session.width(),
+            session.height(),
+            session.device_name(),
+            session.samples(),
+            self.clock.rendering_summary(),
+            session.progressive.samples_per_second() / 1e6
+        )
+    }
+
+    fn update_title(&mut self) {
+        let document = &self.session.document;
+        let name = document.path().and_then(|p| p.file_name()).map_or("untitled look".into(), |n| n.to_string_lossy());
+        let title = format!("{name}{} — lookdev", if document.is_dirty() { " •" } else { "" });
+        if title != self.title {
+            self.window.set_title(&title);
+            self.title = title;
+        }
+    }
+}
+
+/// The layer the selection points at.
+fn selected_layer(document: &Document) -> Result<(ObjectRef, usize)> {
+    let selection = document.selection();
+    match (selection.object, selection.layer) {
+        (Some(object), Some(layer)) => Ok((object, layer)),
+        _ => Err(Error::input("no layer is selected")),
+    }
+}
+
+/// Frame times: a recent mean for the status bar, and every frame spent rendering for the report.
+#[derive(Default)]
+struct FrameClock {
+    frames: u64,
+    recent: Vec<Duration>,
+    rendering: Vec<Duration>,
+}
+
+impl FrameClock {
+    /// Frames in the recent mean.
+    const RECENT: usize = 30;
+
+    fn record(&mut self, time: Duration, rendering: bool) {
+        self.frames += 1;
+        if self.recent.len() == Self::RECENT {
+            self.recent.remove(0);
+        }
+        self.recent.push(time);
+        // The first frames build pipelines and fonts; they are not what an artist waits for.
+        if rendering && self.frames > 3 {
+            self.rendering.push(time);
+        }
+    }
+
+    fn recent_mean(&self) -> Duration {
+        if self.recent.is_empty() {
+            Duration::ZERO
+        } else {
+            self.recent.iter().sum::<Duration>() / self.recent.len() as u32
+        }
+    }
+
+    /// "median 31 ms, 95th percentile 40 ms over 120 frames".
+    fn rendering_summary(&self) -> String {
+        if self.rendering.is_empty() {
+            return "n/a".into();
+        }
+        let mut times: Vec<f64> = self.rendering.iter().map(|d| d.as_secs_f64() * 1e3).collect();
+        times.sort_by(f64::total_cmp);
+        let at = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize];
+        format!("median {:.1} ms, 95th percentile {:.1} ms over {} frames", at(0.5), at(0.95), times.len())
+    }
+}

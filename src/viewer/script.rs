@@ -1,0 +1,350 @@
+//! `--script FILE`: a list of interface actions, one per line, run one per frame through the
+//! same code as the panels (README: `lookdev view`). The whole file is checked before the window
+//! opens; a line that fails while running stops the viewer with the file and line named.
+
+use super::action::{Action, Answer};
+use crate::material::params::{parse_value, Param, Value};
+use crate::render::tonemap::Tonemap;
+use crate::viewer_state::{Edit, ObjectRef, Selection};
+use crate::{Error, Result};
+use std::path::{Path, PathBuf};
+
+/// A checked script.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Script {
+    pub file: PathBuf,
+    /// Each step with its 1-based line.
+    pub steps: Vec<(usize, Step)>,
+}
+
+/// One line of a script.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Step {
+    /// An action that needs nothing more.
+    Do(Action),
+    /// A change to the selected layer, made into an edit once the selection is known.
+    Layer(LayerChange),
+    /// Keep rendering until every pixel has this many samples.
+    WaitSpp(u32),
+}
+
+/// A change to the selected layer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LayerChange {
+    Set(Param, Value),
+    Reset(Param),
+    Remove,
+    Duplicate,
+    Move(usize),
+    Enabled(bool),
+    Invert(bool),
+    Opacity(f32),
+}
+
+impl LayerChange {
+    /// The edit this change makes to `layer` of `object`.
+    pub fn edit(self, object: ObjectRef, layer: usize) -> Edit {
+        match self {
+            LayerChange::Set(param, value) => Edit::SetParam { object, layer, param, value },
+            LayerChange::Reset(param) => Edit::ResetParam { object, layer, param },
+            LayerChange::Remove => Edit::RemoveLayer { object, layer },
+            LayerChange::Duplicate => Edit::DuplicateLayer { object, layer },
+            LayerChange::Move(to) => Edit::MoveLayer { object, from: layer, to },
+            LayerChange::Enabled(enabled) => Edit::SetEnabled { object, layer, enabled },
+            LayerChange::Invert(invert) => Edit::SetInvert { object, layer, invert },
+            LayerChange::Opacity(opacity) => Edit::SetOpacity { object, layer, opacity },
+        }
+    }
+}
+
+/// The commands, for the error that names an unknown one.
+const COMMANDS: &str = "select, set, reset, add, remove, duplicate, move, show, hide, mask, invert, opacity, \
+    rotate, intensity, background, env, exposure, tonemap, spp, seed, undo, redo, pick, wait-spp, save-look, \
+    save-preset, save-image, screenshot, open-look, quit, answer";
+
+impl Script {
+    pub fn load(path: &Path) -> Result<Script> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::input_file(path, format!("cannot read ({e})")))?;
+        Script::parse(&text, path)
+    }
+
+    /// Parses a script; `file` names it in errors. Blank lines and `#` comments are skipped.
+    pub fn parse(text: &str, file: &Path) -> Result<Script> {
+        let mut steps = Vec::new();
+        for (index, raw) in text.lines().enumerate() {
+            let line = raw.split_once('#').map_or(raw, |(code, _)| code).trim();
+            if line.is_empty() {
+                continue;
+            }
+            let (command, rest) = line.split_once(char::is_whitespace).unwrap_or((line, ""));
+            let step = parse_step(command, rest.trim())
+                .map_err(|problem| Error::input_file(format!("{}:{}", file.display(), index + 1), problem))?;
+            steps.push((index + 1, step));
+        }
+        Ok(Script { file: file.to_path_buf(), steps })
+    }
+}
+
+/// Runs a script a step at a time.
+pub struct ScriptRunner {
+    script: Script,
+    next: usize,
+}
+
+impl ScriptRunner {
+    pub fn new(script: Script) -> ScriptRunner {
+        ScriptRunner { script, next: 0 }
+    }
+
+    pub fn finished(&self) -> bool {
+        self.next >= self.script.steps.len()
+    }
+
+    /// The next step and its line; `None` when the script is done or waiting for samples. A
+    /// wait for more samples than the target would never end, so it is an error.
+    pub fn next(&mut self, samples: u32, target: u32) -> Result<Option<(usize, Step)>> {
+        let Some((line, step)) = self.script.steps.get(self.next).cloned() else {
+            return Ok(None);
+        };
+        if let Step::WaitSpp(spp) = step {
+            if spp > target {
+                let problem =
+                    format!("wait-spp {spp} would never end: the target is {target} spp (raise it with `spp {spp}`)");
+                return Err(self.error_at(line, Error::input(problem)));
+            }
+            if samples < spp {
+                return Ok(None);
+            }
+        }
+        self.next += 1;
+        Ok(Some((line, step)))
+    }
+
+    /// An error placed at a line of the script.
+    pub fn error_at(&self, line: usize, error: Error) -> Error {
+        Error { kind: error.kind, message: format!("{}:{line}: {}", self.script.file.display(), error.message) }
+    }
+}
+
+fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
+    let args: Vec<&str> = rest.split_whitespace().collect();
+    let arity = |n: usize| {
+        if args.len() == n {
+            Ok(())
+        } else {
+            Err(format!("'{command}' takes {n} argument{}, not {}", if n == 1 { "" } else { "s" }, args.len()))
+        }
+    };
+    let path = || if rest.is_empty() { Err(format!("'{command}' needs a file")) } else { Ok(PathBuf::from(rest)) };
+    let edit = |edit: Edit| Ok(Step::Do(Action::Edit(edit)));
+    let layer = |change: LayerChange| Ok(Step::Layer(change));
+    match command {
+        "select" => {
+            if args.is_empty() || args.len() > 2 {
+                return Err("'select' takes an object (an id or `default`) and optionally a layer".into());
+            }
+            let object = match args[0] {
+                "default" => ObjectRef::Default,
+                id => ObjectRef::Id(number(id, "object id")?),
+            };
+            let layer = args.get(1).map(|l| number(l, "layer")).transpose()?;
+            Ok(Step::Do(Action::Select(Selection { object: Some(object), layer })))
+        }
+        "set" => {
+            let (name, value) = rest.split_once(char::is_whitespace).ok_or("'set' takes a parameter and a value")?;
+            let param = parameter(name)?;
+            let value = parse_value(param, value.trim())?;
+            layer(LayerChange::Set(param, value))
+        }
+        "reset" => {
+            arity(1)?;
+            layer(LayerChange::Reset(parameter(args[0])?))
+        }
+        "add" => {
+            arity(1)?;
+            Ok(Step::Do(Action::AddPresetLayer(args[0].to_string())))
+        }
+        "remove" | "duplicate" | "show" | "hide" => {
+            arity(0)?;
+            layer(match command {
+                "remove" => LayerChange::Remove,
+                "duplicate" => LayerChange::Duplicate,
+                "show" => LayerChange::Enabled(true),
+                _ => LayerChange::Enabled(false),
+            })
+        }
+        "move" => {
+            arity(1)?;
+            layer(LayerChange::Move(number(args[0], "layer")?))
+        }
+        "mask" => {
+            arity(1)?;
+            Ok(Step::Do(Action::SetMask(if args[0] == "none" { None } else { Some(args[0].to_string()) })))
+        }
+        "invert" => {
+            arity(1)?;
+            layer(LayerChange::Invert(switch(args[0])?))
+        }
+        "opacity" => {
+            arity(1)?;
+            layer(LayerChange::Opacity(float(args[0])?))
+        }
+        "rotate" => {
+            arity(1)?;
+            edit(Edit::SetRotation(float(args[0])?))
+        }
+        "intensity" => {
+            arity(1)?;
+            edit(Edit::SetIntensity(float(args[0])?))
+        }
+        "background" => {
+            arity(1)?;
+            edit(Edit::SetBackground(switch(args[0])?))
+        }
+        "env" => Ok(Step::Do(Action::OpenEnvironment(if rest == "studio" { None } else { Some(path()?) }))),
+        "exposure" => {
+            arity(1)?;
+            edit(Edit::SetExposure(float(args[0])?))
+        }
+        "tonemap" => {
+            arity(1)?;
+            let tonemap = Tonemap::from_name(args[0])
+                .ok_or_else(|| format!("unknown tone map '{}' (expected linear, neutral, aces, agx)", args[0]))?;
+            edit(Edit::SetTonemap(tonemap))
+        }
+        "spp" => {
+            arity(1)?;
+            edit(Edit::SetTargetSpp(number(args[0], "spp")?))
+        }
+        "seed" => {
+            arity(1)?;
+            edit(Edit::SetSeed(number(args[0], "seed")?))
+        }
+        "undo" | "redo" | "quit" => {
+            arity(0)?;
+            Ok(Step::Do(match command {
+                "undo" => Action::Undo,
+                "redo" => Action::Redo,
+                _ => Action::Quit,
+            }))
+        }
+        "pick" => {
+            arity(2)?;
+            Ok(Step::Do(Action::Pick { x: number(args[0], "x")?, y: number(args[1], "y")? }))
+        }
+        "wait-spp" => {
+            arity(1)?;
+            let spp = number(args[0], "spp")?;
+            if spp == 0 {
+                return Err("'wait-spp' needs at least 1 sample".into());
+            }
+            Ok(Step::WaitSpp(spp))
+        }
+        "save-look" => Ok(Step::Do(Action::SaveLook(if rest.is_empty() { None } else { Some(path()?) }))),
+        "save-preset" => {
+            let force = args.contains(&"--force");
+            let names: Vec<&&str> = args.iter().filter(|a| **a != "--force").collect();
+            if names.len() != 1 {
+                return Err("'save-preset' takes a name and optionally --force".into());
+            }
+            Ok(Step::Do(Action::SaveLayerAsPreset {
+                name: names[0].to_string(),
+                description: String::new(),
+                tags: Vec::new(),
+                force,
+            }))
+        }
+        "save-image" => Ok(Step::Do(Action::SaveImage(path()?))),
+        "screenshot" => Ok(Step::Do(Action::Screenshot(path()?))),
+        "open-look" => Ok(Step::Do(Action::OpenLook(path()?))),
+        "answer" => {
+            arity(1)?;
+            let answer = match args[0] {
+                "save" => Answer::Save,
+                "discard" => Answer::Discard,
+                "cancel" => Answer::Cancel,
+                other => return Err(format!("unknown answer '{other}' (expected save, discard or cancel)")),
+            };
+            Ok(Step::Do(Action::Answer(answer)))
+        }
+        other => Err(format!("unknown command '{other}' (expected one of: {COMMANDS})")),
+    }
+}
+
+fn parameter(name: &str) -> std::result::Result<Param, String> {
+    Param::from_name(name).ok_or_else(|| format!("unknown parameter '{name}' (expected {})", Param::all_names()))
+}
+
+fn number<T: std::str::FromStr>(text: &str, what: &str) -> std::result::Result<T, String> {
+    text.parse().map_err(|_| format!("{what} '{text}' is not a whole number ≥ 0"))
+}
+
+fn float(text: &str) -> std::result::Result<f32, String> {
+    text.parse::<f32>().ok().filter(|v| v.is_finite()).ok_or_else(|| format!("'{text}' is not a finite number"))
+}
+
+fn switch(text: &str) -> std::result::Result<bool, String> {
+    match text {
+        "on" | "true" => Ok(true),
+        "off" | "false" => Ok(false),
+        _ => Err(format!("'{text}' is not on or off")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Script> {
+        Script::parse(text, Path::new("edit.script"))
+    }
+
+    #[test]
+    fn every_command_parses_to_its_action() {
+        let script = parse(
+            "# a comment\n\nselect 1 0\nset roughness 0.25\nset base_color 0.8, 0.1, 0.1  # red\nadd gold\n\
+             mask stripes\nrotate -45\nenv studio\nwait-spp 4\nsave-look out/look.toml\nanswer discard\n",
+        )
+        .unwrap();
+        let steps: Vec<&Step> = script.steps.iter().map(|(_, s)| s).collect();
+        assert_eq!(script.steps[0].0, 3, "lines count from 1, comments and blanks included");
+        assert_eq!(*steps[0], Step::Do(Action::Select(Selection { object: Some(ObjectRef::Id(1)), layer: Some(0) })));
+        assert_eq!(*steps[1], Step::Layer(LayerChange::Set(Param::Roughness, Value::Scalar(0.25))));
+        assert_eq!(*steps[2], Step::Layer(LayerChange::Set(Param::BaseColor, Value::Color([0.8, 0.1, 0.1]))));
+        assert_eq!(*steps[3], Step::Do(Action::AddPresetLayer("gold".into())));
+        assert_eq!(*steps[4], Step::Do(Action::SetMask(Some("stripes".into()))));
+        assert_eq!(*steps[5], Step::Do(Action::Edit(Edit::SetRotation(-45.0))));
+        assert_eq!(*steps[6], Step::Do(Action::OpenEnvironment(None)));
+        assert_eq!(*steps[7], Step::WaitSpp(4));
+        assert_eq!(*steps[8], Step::Do(Action::SaveLook(Some(PathBuf::from("out/look.toml")))));
+        assert_eq!(*steps[9], Step::Do(Action::Answer(Answer::Discard)));
+    }
+
+    #[test]
+    fn a_bad_line_is_named_with_its_problem() {
+        let cases = [
+            ("frobnicate\n", "edit.script:1: unknown command 'frobnicate'"),
+            ("\nset shininess 3\n", "edit.script:2: unknown parameter 'shininess'"),
+            ("set roughness lots\n", "edit.script:1:"),
+            ("rotate nan\n", "'nan' is not a finite number"),
+            ("select\n", "'select' takes an object"),
+            ("wait-spp 0\n", "at least 1 sample"),
+            ("background maybe\n", "'maybe' is not on or off"),
+            ("undo now\n", "'undo' takes 0 arguments, not 1"),
+        ];
+        for (text, expected) in cases {
+            let message = parse(text).unwrap_err().to_string();
+            assert!(message.contains(expected), "{text:?}: {message}");
+        }
+    }
+
+    #[test]
+    fn layer_changes_become_edits_of_the_selected_layer() {
+        let object = ObjectRef::Id(2);
+        assert_eq!(LayerChange::Move(0).edit(object, 3), Edit::MoveLayer { object, from: 3, to: 0 });
+        assert_eq!(
+            LayerChange::Reset(Param::Sheen).edit(object, 1),
+            Edit::ResetParam { object, layer: 1, param: Param::Sheen }
+        );
+    }
+}

@@ -1,0 +1,374 @@
+//! A viewing session: the document being edited and the renderer that shows it, kept in step.
+//! Each frame, [`Session::sync`] hands the renderer only what changed (new stacks when the
+//! materials changed, an environment, lighting, seed), so that an edit costs one restart and
+//! an exposure change costs no samples at all.
+
+use super::progressive::Progressive;
+use crate::environment::{self, Environment, LoadOptions};
+use crate::gbuffer::GBuffer;
+use crate::gpu::{Context, Image};
+use crate::material::params::Params;
+use crate::material::stack::{layer_weights, LayerWeight, PackedStacks};
+use crate::render::output::{self, OutputFormat};
+use crate::render::scene::covered_object_ids;
+use crate::render::tonemap::Tonemap;
+use crate::render::{Lighting, Renderer};
+use crate::viewer_state::{Document, ObjectRef};
+use crate::{Error, Result};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// Environments kept loaded, so that undoing a switch does not read the file again.
+const KEPT_ENVIRONMENTS: usize = 3;
+
+/// What the renderer was last given.
+struct Shown {
+    material_revision: u64,
+    environment: Option<PathBuf>,
+    lighting: Lighting,
+    seed: u32,
+    exposure: f32,
+    tonemap: Tonemap,
+}
+
+/// Everything known about one pixel, for the inspector.
+#[derive(Clone, Debug)]
+pub struct Inspection {
+    pub x: u32,
+    pub y: u32,
+    pub object_id: u32,
+    pub coverage: f32,
+    /// Every g-buffer mask's value here, by name.
+    pub masks: Vec<(String, f32)>,
+    /// The stack that shades the pixel, and each of its layers' weight here (`None`: hidden).
+    pub stack: Option<ObjectRef>,
+    pub layers: Vec<(String, Option<LayerWeight>)>,
+    /// The blended material here.
+    pub params: Params,
+    /// Linear radiance (alpha 1 with the background on, else the coverage) and its sample count.
+    pub radiance: [f32; 4],
+    pub samples: u32,
+}
+
+impl std::fmt::Display for Inspection {
+    /// One line, as a script's `pick` prints it.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "pixel {},{}: object {}, coverage {:.4}", self.x, self.y, self.object_id, self.coverage)?;
+        for (name, value) in &self.masks {
+            write!(f, ", mask.{name} {value:.4}")?;
+        }
+        if let Some(stack) = self.stack {
+            write!(f, "; {stack}:")?;
+            for (index, (label, weight)) in self.layers.iter().enumerate() {
+                match weight {
+                    Some(w) => write!(f, " [{index} {label} blend {:.4} share {:.4}]", w.blend, w.contribution)?,
+                    None => write!(f, " [{index} {label} hidden]")?,
+                }
+            }
+            write!(f, "; material")?;
+            for param in crate::material::Param::ALL {
+                write!(f, " {}={}", param.name(), self.params.get(param))?;
+            }
+        }
+        let [r, g, b, a] = self.radiance;
+        write!(f, "; radiance {r:.6},{g:.6},{b:.6},{a:.6} at {} spp", self.samples)
+    }
+}
+
+/// The document, the renderer, and what the renderer shows of the document.
+pub struct Session {
+    ctx: Context,
+    pub gbuffer: GBuffer,
+    /// The g-buffer's file, or "built-in shader ball".
+    pub gbuffer_name: PathBuf,
+    pub document: Document,
+    renderer: Renderer,
+    pub progressive: Progressive,
+    packed: PackedStacks,
+    /// The object ids that are shaded, ascending.
+    objects: Vec<u32>,
+    masks: Vec<String>,
+    env_options: LoadOptions,
+    environments: Vec<(Option<PathBuf>, Environment)>,
+    shown: Shown,
+    /// When the last change reached the renderer, and how long its first full pass took.
+    changed_at: Instant,
+    pub first_pass_after_change: Option<Duration>,
+    pub inspection: Option<Inspection>,
+    /// `--exit-after-spp`: the sample count to stop at, whatever the look's target.
+    target_override: Option<u32>,
+}
+
+impl Session {
+    /// `environment` is the one `document`'s settings name, already loaded.
+    pub fn new(
+        ctx: &Context,
+        gbuffer: GBuffer,
+        gbuffer_name: PathBuf,
+        document: Document,
+        environment: Environment,
+        env_options: LoadOptions,
+    ) -> Result<Session> {
+        let objects = covered_object_ids(&gbuffer);
+        let masks: Vec<String> = gbuffer.masks.keys().cloned().collect();
+        let packed = PackedStacks::pack(document.look(), objects.iter().copied(), &masks, &gbuffer_name)?;
+        let settings = document.settings().clone();
+        let mut renderer = Renderer::new(ctx, &gbuffer, &environment)?;
+        renderer.set_stacks(&packed)?;
+        renderer.set_lighting(settings.lighting);
+        renderer.set_seed(settings.seed);
+        Ok(Session {
+            ctx: ctx.clone(),
+            progressive: Progressive::new(),
+            gbuffer,
+            gbuffer_name,
+            shown: Shown {
+                material_revision: document.material_revision(),
+                environment: settings.environment.clone(),
+                lighting: settings.lighting,
+                seed: settings.seed,
+                exposure: settings.exposure,
+                tonemap: settings.tonemap,
+            },
+            document,
+            renderer,
+            packed,
+            objects,
+            masks,
+            env_options,
+            environments: vec![(settings.environment, environment)],
+            changed_at: Instant::now(),
+            first_pass_after_change: None,
+            inspection: None,
+            target_override: None,
+        })
+    }
+
+    /// Stops accumulation at `spp` instead of the document's target, without changing the look.
+    pub fn override_target(&mut self, spp: u32) {
+        self.target_override = Some(spp);
+    }
+
+    /// The shaded object ids, ascending.
+    pub fn objects(&self) -> &[u32] {
+        &self.objects
+    }
+
+    /// The g-buffer's mask names.
+    pub fn masks(&self) -> &[String] {
+        &self.masks
+    }
+
+    pub fn width(&self) -> u32 {
+        self.gbuffer.width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.gbuffer.height
+    }
+
+    /// Samples every pixel has.
+    pub fn samples(&self) -> u32 {
+        self.renderer.samples()
+    }
+
+    /// Where accumulation stops.
+    pub fn target(&self) -> u32 {
+        self.target_override.unwrap_or(self.document.settings().spp)
+    }
+
+    pub fn display_image(&self) -> &Image {
+        self.renderer.display_image()
+    }
+
+    pub fn device_name(&self) -> &str {
+        &self.ctx.info().name
+    }
+
+    /// Loads an environment (or the built-in studio) and keeps it for [`Session::sync`]: called
+    /// before the edit that switches to it, so that a file that does not load changes nothing.
+    pub fn load_environment(&mut self, path: Option<&Path>) -> Result<()> {
+        let key = path.map(Path::to_path_buf);
+        if let Some(i) = self.environments.iter().position(|(p, _)| *p == key) {
+            let entry = self.environments.remove(i);
+            self.environments.push(entry);
+            return Ok(());
+        }
+        let environment = match path {
+            Some(path) => environment::load::load(path, &self.env_options)?,
+            None => Environment::studio(),
+        };
+        self.environments.push((key, environment));
+        if self.environments.len() > KEPT_ENVIRONMENTS {
+            // Never the one on screen: it may be needed again by an undo.
+            let on_screen = self.shown.environment.clone();
+            if let Some(i) = self.environments.iter().position(|(p, _)| *p != on_screen) {
+                self.environments.remove(i);
+            }
+        }
+        Ok(())
+    }
+
+    /// Gives the renderer whatever changed in the document since the last call. An error leaves
+    /// the renderer showing the previous state; the caller undoes the change.
+    pub fn sync(&mut self) -> Result<()> {
+        self.apply_changes(false)
+    }
+
+    /// [`Session::sync`]; with `everything`, as if every part had changed.
+    fn apply_changes(&mut self, everything: bool) -> Result<()> {
+        let settings = self.document.settings().clone();
+        let mut restarted = false;
+        if everything || self.document.material_revision() != self.shown.material_revision {
+            let packed = PackedStacks::pack(
+                self.document.look(),
+                self.objects.iter().copied(),
+                &self.masks,
+                &self.gbuffer_name,
+            )?;
+            if everything || packed != self.packed {
+                self.renderer.set_stacks(&packed)?;
+                self.packed = packed;
+                restarted = true;
+            }
+            self.shown.material_revision = self.document.material_revision();
+        }
+        if everything || settings.environment != self.shown.environment {
+            self.load_environment(settings.environment.as_deref())?;
+            let (_, environment) = self.environments.last().expect("just loaded");
+            self.renderer.set_environment(environment)?;
+            self.shown.environment = settings.environment.clone();
+            restarted = true;
+        }
+        if everything || settings.lighting != self.shown.lighting || settings.seed != self.shown.seed {
+            self.renderer.set_lighting(settings.lighting);
+            self.renderer.set_seed(settings.seed);
+            self.shown.lighting = settings.lighting;
+            self.shown.seed = settings.seed;
+            restarted = true;
+        }
+        if restarted {
+            self.progressive.restart();
+            self.changed_at = Instant::now();
+            self.first_pass_after_change = None;
+        }
+        if everything || (settings.exposure, settings.tonemap) != (self.shown.exposure, self.shown.tonemap) {
+            self.shown.exposure = settings.exposure;
+            self.shown.tonemap = settings.tonemap;
+            // The same samples, shown anew: nothing restarts.
+            self.renderer.finalize_rows(0, self.height(), settings.exposure, settings.tonemap)?;
+        }
+        Ok(())
+    }
+
+    /// Relights one frame's band, if the target is not reached. Returns whether it did.
+    pub fn step(&mut self) -> Result<bool> {
+        let target = self.target();
+        let settings = self.document.settings();
+        let (exposure, tonemap) = (settings.exposure, settings.tonemap);
+        let stepped = self.progressive.step(&mut self.renderer, target, exposure, tonemap)?;
+        if self.first_pass_after_change.is_none() && self.renderer.samples() > 0 {
+            self.first_pass_after_change = Some(self.changed_at.elapsed());
+        }
+        Ok(stepped)
+    }
+
+    /// Brings every row to the same sample count (rows may be a band apart mid-pass), so that
+    /// what is saved is a whole number of passes, as `lookdev render` makes.
+    fn complete_pass(&mut self) -> Result<()> {
+        let settings = self.document.settings();
+        let (exposure, tonemap) = (settings.exposure, settings.tonemap);
+        while let Some((first, rows)) = self.renderer.lagging_rows() {
+            self.renderer.render_rows(first, rows, 1)?;
+            self.renderer.finalize_rows(first, rows, exposure, tonemap)?;
+        }
+        Ok(())
+    }
+
+    /// Saves the render as `lookdev render --out` would at the same spp and seed: a PNG of the
+    /// display pixels (exposure and tone map applied), or an EXR of linear radiance.
+    pub fn save_image(&mut self, path: &Path) -> Result<u32> {
+        let format = OutputFormat::from_path(path)?;
+        self.complete_pass()?;
+        if self.samples() == 0 {
+            return Err(Error::input_file(path, "not saved: nothing has been rendered yet"));
+        }
+        let settings = self.document.settings().clone();
+        let (width, height) = (self.width(), self.height());
+        match format {
+            OutputFormat::Exr => {
+                let radiance = self.renderer.read_radiance()?;
+                // Reading radiance remade the display pixels in linear; show them as before.
+                self.renderer.finalize_rows(0, height, settings.exposure, settings.tonemap)?;
+                output::write_exr(path, width, height, &radiance, settings.lighting.background)?;
+            }
+            OutputFormat::Png => {
+                let pixels = self.renderer.read_display(settings.exposure, settings.tonemap)?;
+                output::write_png(path, width, height, &pixels, !settings.lighting.background)?;
+            }
+        }
+        Ok(self.samples())
+    }
+
+    /// Inspects pixel (x, y): its object, masks, layer weights, material and radiance.
+    pub fn inspect(&mut self, x: u32, y: u32) -> Result<Inspection> {
+        if x >= self.width() || y >= self.height() {
+            return Err(Error::input(format!("pixel {x},{y} is outside the {}x{} image", self.width(), self.height())));
+        }
+        let index = (y * self.width() + x) as usize;
+        let object_id = self.gbuffer.object_id[index];
+        let coverage = self.gbuffer.coverage[index];
+        let masks: Vec<(String, f32)> =
+            self.gbuffer.masks.iter().map(|(name, values)| (name.clone(), values[index])).collect();
+        let mask_value = |name: &str| masks.iter().find(|(n, _)| n == name).map_or(0.0, |(_, v)| *v);
+        let shaded = coverage > 0.0;
+        let stack = shaded.then(|| self.stack_of(object_id));
+        let layers = match stack.and_then(|object| self.document.stack(object)) {
+            Some(stack) => {
+                let weights = layer_weights(stack, mask_value);
+                stack.layers.iter().zip(weights).map(|(layer, weight)| (layer_label(layer), weight)).collect()
+            }
+            None => Vec::new(),
+        };
+        let params = if shaded {
+            self.packed.resolve_pixel(object_id, |i| mask_value(&self.packed.masks[i]))
+        } else {
+            Params::default()
+        };
+        let settings = self.document.settings();
+        let radiance = if self.samples() > 0 {
+            self.renderer.read_radiance_pixel(x, y, settings.exposure, settings.tonemap)?
+        } else {
+            [0.0; 4]
+        };
+        let inspection =
+            Inspection { x, y, object_id, coverage, masks, stack, layers, params, radiance, samples: self.samples() };
+        self.inspection = Some(inspection.clone());
+        Ok(inspection)
+    }
+
+    /// The stack that shades an object: its own, else the default one.
+    pub fn stack_of(&self, object_id: u32) -> ObjectRef {
+        let own = self.document.look().objects.iter().any(|o| o.id == Some(object_id));
+        if own {
+            ObjectRef::Id(object_id)
+        } else {
+            ObjectRef::Default
+        }
+    }
+
+    /// Replaces the document (another look was opened) and everything shown of it. On error
+    /// (the look's masks or environment do not fit), the old document stays.
+    pub fn replace_document(&mut self, document: Document) -> Result<()> {
+        PackedStacks::pack(document.look(), self.objects.iter().copied(), &self.masks, &self.gbuffer_name)?;
+        self.load_environment(document.settings().environment.as_deref())?;
+        self.document = document;
+        self.inspection = None;
+        self.apply_changes(true)
+    }
+}
+
+/// How a layer is named in the interface: its preset, or "custom".
+pub fn layer_label(layer: &crate::material::look::Layer) -> String {
+    layer.preset.clone().unwrap_or_else(|| "custom".to_string())
+}

@@ -1,0 +1,261 @@
+//! The left panel: objects, the selected object's layer stack (top layer first, as in a paint
+//! program), and the selected layer's mask, opacity and eleven parameters.
+
+use super::super::action::Action;
+use super::super::session::{layer_label, Session};
+use crate::material::look::{Layer, ObjectStack};
+use crate::material::params::{Param, Value};
+use crate::viewer_state::{Edit, ObjectRef, Selection};
+use egui::{Color32, RichText};
+
+/// Shows the panel; returns true when the artist asked to add a layer from the library.
+pub fn show(ui: &mut egui::Ui, session: &Session, actions: &mut Vec<Action>) -> bool {
+    let document = &session.document;
+    let selection = document.selection();
+    objects(ui, session, selection, actions);
+    ui.separator();
+    let Some(object) = selection.object else {
+        ui.label("Select an object, or click one in the image.");
+        return false;
+    };
+    let Some(stack) = document.stack(object) else {
+        ui.label("This object has no stack yet.");
+        return add_button(ui);
+    };
+    let own = document.look().objects.iter().any(|o| o.id == object.id());
+    if !own {
+        ui.label(RichText::new("Shows the default stack; the first edit gives this object a copy of its own.").weak());
+    }
+    let add = layer_list(ui, object, stack, selection, actions);
+    if let Some(index) = selection.layer.filter(|&i| i < stack.layers.len()) {
+        ui.separator();
+        layer_properties(ui, session, object, index, &stack.layers[index], actions);
+        ui.separator();
+        parameters(ui, session, object, index, &stack.layers[index], actions);
+    }
+    add
+}
+
+fn objects(ui: &mut egui::Ui, session: &Session, selection: Selection, actions: &mut Vec<Action>) {
+    ui.heading("Objects");
+    let look = session.document.look();
+    let mut row = |ui: &mut egui::Ui, object: ObjectRef, text: String| {
+        let selected = selection.object == Some(object);
+        if ui.selectable_label(selected, text).clicked() && !selected {
+            let top = session.document.stack(object).map(|s| s.layers.len().saturating_sub(1));
+            actions.push(Action::Select(Selection { object: Some(object), layer: top }));
+        }
+    };
+    row(ui, ObjectRef::Default, "Default stack".to_string());
+    for &id in session.objects() {
+        let name = session.gbuffer.object_names.get(&id).map(|n| format!(" {n}")).unwrap_or_default();
+        let own = look.objects.iter().any(|o| o.id == Some(id));
+        let note = if own { "" } else { "  (default stack)" };
+        row(ui, ObjectRef::Id(id), format!("{id}{name}{note}"));
+    }
+}
+
+fn add_button(ui: &mut egui::Ui) -> bool {
+    ui.button("➕ Add layer…").on_hover_text("Add a layer from the preset library").clicked()
+}
+
+/// The stack, top layer first. Returns true when "Add layer" was clicked.
+fn layer_list(
+    ui: &mut egui::Ui,
+    object: ObjectRef,
+    stack: &ObjectStack,
+    selection: Selection,
+    actions: &mut Vec<Action>,
+) -> bool {
+    let count = stack.layers.len();
+    let mut add = false;
+    ui.horizontal(|ui| {
+        ui.heading("Layers");
+        add = add_button(ui);
+        let selected = selection.layer.filter(|&i| i < count);
+        if let Some(layer) = selected {
+            if ui.button("Duplicate").on_hover_text("Copy the layer, just above it").clicked() {
+                actions.push(Action::Edit(Edit::DuplicateLayer { object, layer }));
+                actions.push(Action::Select(Selection { object: Some(object), layer: Some(layer + 1) }));
+            }
+            let remove = ui.add_enabled(count > 1, egui::Button::new("Remove")).on_hover_text("Remove the layer");
+            if remove.clicked() {
+                actions.push(Action::Edit(Edit::RemoveLayer { object, layer }));
+            }
+        }
+    });
+    ui.label(RichText::new("Drag ☰ to reorder. The bottom layer fills; each layer above blends over it.").weak());
+    let mut dropped: Option<(usize, usize)> = None;
+    for index in (0..count).rev() {
+        let layer = &stack.layers[index];
+        let row = ui.horizontal(|ui| {
+            let handle = ui.dnd_drag_source(egui::Id::new(("layer", index)), index, |ui| ui.label("☰")).response;
+            handle.on_hover_text("Drag to move the layer");
+            let mut enabled = layer.enabled;
+            if ui.checkbox(&mut enabled, "").on_hover_text("Show or hide the layer").changed() {
+                actions.push(Action::Edit(Edit::SetEnabled { object, layer: index, enabled }));
+            }
+            let mut text = RichText::new(layer_summary(layer, index));
+            if !layer.enabled {
+                text = text.weak().strikethrough();
+            }
+            let selected = selection.layer == Some(index);
+            if ui.selectable_label(selected, text).clicked() {
+                actions.push(Action::Select(Selection { object: Some(object), layer: Some(index) }));
+            }
+        });
+        if let Some(from) = row.response.dnd_release_payload::<usize>() {
+            dropped = Some((*from, index));
+        }
+        if row.response.dnd_hover_payload::<usize>().is_some() {
+            let rect = row.response.rect;
+            ui.painter().hline(rect.x_range(), rect.top(), egui::Stroke::new(2.0, ui.visuals().selection.bg_fill));
+        }
+    }
+    if let Some((from, to)) = dropped.filter(|(from, to)| from != to) {
+        actions.push(Action::Edit(Edit::MoveLayer { object, from, to }));
+        actions.push(Action::Select(Selection { object: Some(object), layer: Some(to) }));
+    }
+    add
+}
+
+/// "gold · stripes (inverted) · 60%".
+fn layer_summary(layer: &Layer, index: usize) -> String {
+    let mut text = layer_label(layer);
+    if index > 0 {
+        if let Some(mask) = &layer.mask {
+            text += &format!(" · {mask}{}", if layer.invert { " (inverted)" } else { "" });
+        }
+        if layer.opacity < 1.0 {
+            text += &format!(" · {:.0}%", layer.opacity * 100.0);
+        }
+    }
+    text
+}
+
+fn layer_properties(
+    ui: &mut egui::Ui,
+    session: &Session,
+    object: ObjectRef,
+    index: usize,
+    layer: &Layer,
+    actions: &mut Vec<Action>,
+) {
+    ui.heading(format!("Layer {index}: {}", layer_label(layer)));
+    if index == 0 {
+        ui.label(RichText::new("The bottom layer fills the object: its mask and opacity do not apply.").weak());
+    }
+    ui.add_enabled_ui(index > 0, |ui| {
+        egui::Grid::new("layer properties").num_columns(2).show(ui, |ui| {
+            ui.label("Mask");
+            let current = layer.mask.clone().unwrap_or_else(|| "none".into());
+            egui::ComboBox::from_id_salt("mask").selected_text(current).show_ui(ui, |ui| {
+                if ui.selectable_label(layer.mask.is_none(), "none").clicked() {
+                    actions.push(Action::SetMask(None));
+                }
+                for mask in session.masks() {
+                    if ui.selectable_label(layer.mask.as_ref() == Some(mask), mask).clicked() {
+                        actions.push(Action::SetMask(Some(mask.clone())));
+                    }
+                }
+            });
+            ui.end_row();
+            ui.label("Invert");
+            let mut invert = layer.invert;
+            if ui.checkbox(&mut invert, "").changed() {
+                actions.push(Action::Edit(Edit::SetInvert { object, layer: index, invert }));
+            }
+            ui.end_row();
+            ui.label("Opacity");
+            let mut opacity = layer.opacity;
+            if ui.add(egui::Slider::new(&mut opacity, 0.0..=1.0)).changed() {
+                actions.push(Action::Drag(Edit::SetOpacity { object, layer: index, opacity }));
+            }
+            ui.end_row();
+        });
+    });
+}
+
+fn parameters(
+    ui: &mut egui::Ui,
+    session: &Session,
+    object: ObjectRef,
+    index: usize,
+    layer: &Layer,
+    actions: &mut Vec<Action>,
+) {
+    let document = &session.document;
+    ui.heading("Parameters");
+    ui.horizontal(|ui| {
+        override_dot(ui, true);
+        ui.label(RichText::new("overridden here").weak());
+        override_dot(ui, false);
+        ui.label(RichText::new("the preset's value").weak());
+    });
+    egui::Grid::new("parameters").num_columns(4).spacing([6.0, 4.0]).show(ui, |ui| {
+        for param in Param::ALL {
+            let overridden = document.is_overridden(object, index, param);
+            let preset_value = document.preset_value(object, index, param);
+            override_dot(ui, overridden).on_hover_text(if overridden {
+                format!("Overridden; the preset has {preset_value}")
+            } else {
+                "The preset's value".to_string()
+            });
+            ui.label(param.name());
+            let value = layer.params.get(param);
+            let mut changed = None;
+            match value {
+                Value::Color(mut rgb) => {
+                    ui.horizontal(|ui| {
+                        // egui's picker works in sRGB and hands back linear values, as stored.
+                        if egui::widgets::color_picker::color_edit_button_rgb(ui, &mut rgb).changed() {
+                            changed = Some(Value::Color(rgb));
+                        }
+                        for channel in 0..3 {
+                            let drag =
+                                egui::DragValue::new(&mut rgb[channel]).range(0.0..=1.0).speed(0.002).max_decimals(4);
+                            if ui.add(drag).on_hover_text("Linear value").changed() {
+                                changed = Some(Value::Color(rgb));
+                            }
+                        }
+                    });
+                }
+                Value::Scalar(mut v) => {
+                    ui.horizontal(|ui| {
+                        // The slider spans the plausible range; the field takes typed values up
+                        // to the format's limit.
+                        let slider = egui::Slider::new(&mut v, 0.0..=1.0)
+                            .show_value(false)
+                            .clamping(egui::SliderClamping::Never);
+                        if ui.add(slider).changed() {
+                            changed = Some(Value::Scalar(v.clamp(0.0, param.max())));
+                        }
+                        let field = egui::DragValue::new(&mut v).range(0.0..=param.max()).speed(0.005).max_decimals(4);
+                        if ui.add(field).on_hover_text(format!("0 to {}", param.max())).changed() {
+                            changed = Some(Value::Scalar(v));
+                        }
+                    });
+                }
+            }
+            if let Some(value) = changed {
+                actions.push(Action::Drag(Edit::SetParam { object, layer: index, param, value }));
+            }
+            let reset = ui.add_enabled(overridden, egui::Button::new("↺").small());
+            if reset.on_hover_text("Reset to the preset's value").clicked() {
+                actions.push(Action::Edit(Edit::ResetParam { object, layer: index, param }));
+            }
+            ui.end_row();
+        }
+    });
+}
+
+/// A filled dot for an overridden parameter, a ring for one at its preset's value.
+fn override_dot(ui: &mut egui::Ui, overridden: bool) -> egui::Response {
+    let (rect, response) = ui.allocate_exact_size(egui::vec2(12.0, 12.0), egui::Sense::hover());
+    if overridden {
+        ui.painter().circle_filled(rect.center(), 4.0, ui.visuals().warn_fg_color);
+    } else {
+        ui.painter().circle_stroke(rect.center(), 3.5, egui::Stroke::new(1.0, Color32::from_gray(110)));
+    }
+    response
+}

@@ -1,0 +1,246 @@
+//! The viewer's panels. They read the session and emit [`Action`]s; nothing here changes the
+//! document directly, so the panels and `--script` share one path.
+//!
+//! Layout: a menu bar, a status bar, the layer stacks on the left, light, render settings and
+//! the pixel inspector on the right, the image in the middle, and windows for the preset
+//! library, file choosing, saving a preset and the unsaved-edits question.
+
+mod browser;
+mod dialogs;
+mod inspector;
+mod layers;
+mod lighting;
+mod viewport;
+
+pub use dialogs::{FileDialog, FilePurpose};
+pub use viewport::ImagePlacement;
+
+use super::action::Action;
+use super::session::Session;
+use super::thumbnails::Thumbnails;
+use egui::{Key, KeyboardShortcut, Modifiers};
+use std::time::{Duration, Instant};
+
+/// How long a status message stays.
+const MESSAGE_TIME: Duration = Duration::from_secs(8);
+
+/// A line in the status bar: what just happened, or what went wrong.
+pub struct Message {
+    pub text: String,
+    pub error: bool,
+    pub since: Instant,
+}
+
+/// Why the unsaved-edits question is being asked.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Pending {
+    Quit,
+    Open(std::path::PathBuf),
+}
+
+/// Timings the status bar shows.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FrameFigures {
+    /// Mean frame time over the last second or so.
+    pub frame: Duration,
+}
+
+/// What the panels show that is not in the session.
+pub struct Frame<'a> {
+    pub session: &'a Session,
+    pub view_texture: egui::TextureId,
+    pub pending: Option<&'a Pending>,
+    pub figures: FrameFigures,
+}
+
+/// The interface's own state: view, open windows, what is being typed.
+#[derive(Default)]
+pub struct Interface {
+    pub viewport: viewport::Viewport,
+    browser: browser::Browser,
+    pub file_dialog: Option<FileDialog>,
+    save_preset: Option<dialogs::SavePresetForm>,
+    pub message: Option<Message>,
+    /// Where the image was drawn last frame, in window pixels.
+    pub placement: Option<ImagePlacement>,
+}
+
+impl Interface {
+    /// Shows a message in the status bar.
+    pub fn tell(&mut self, text: impl Into<String>, error: bool) {
+        self.message = Some(Message { text: text.into(), error, since: Instant::now() });
+    }
+
+    /// The library browser's list is stale (a preset was saved).
+    pub fn refresh_library(&mut self) {
+        self.browser.refresh();
+    }
+
+    /// Lays out and runs one frame of the interface.
+    pub fn show(&mut self, ui: &mut egui::Ui, frame: &Frame, thumbnails: &mut Thumbnails, actions: &mut Vec<Action>) {
+        self.shortcuts(ui.ctx(), frame, actions);
+        egui::Panel::top("menu").show(ui, |ui| self.menu(ui, frame, actions));
+        egui::Panel::bottom("status").show(ui, |ui| self.status(ui, frame));
+        egui::Panel::left("stack").default_size(340.0).show(ui, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                let open_browser = layers::show(ui, frame.session, actions);
+                if open_browser {
+                    self.browser.open = true;
+                }
+            })
+        });
+        egui::Panel::right("light").default_size(300.0).show(ui, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                lighting::show(ui, frame.session, &mut self.file_dialog, actions);
+                ui.separator();
+                inspector::show(ui, frame.session);
+            })
+        });
+        egui::CentralPanel::no_frame().show(ui, |ui| {
+            self.placement = Some(self.viewport.show(ui, frame.session, frame.view_texture, actions));
+        });
+        let ctx = ui.ctx().clone();
+        self.browser.show(&ctx, frame.session, thumbnails, actions, &mut self.message);
+        if let Some(form) = &mut self.save_preset {
+            if !form.show(&ctx, actions) {
+                self.save_preset = None;
+            }
+        }
+        if let Some(dialog) = &mut self.file_dialog {
+            if !dialog.show(&ctx, actions) {
+                self.file_dialog = None;
+            }
+        }
+        if let Some(pending) = frame.pending {
+            dialogs::unsaved_question(&ctx, frame.session, pending, actions);
+        }
+        // A drag of any control ends when the pointer is let go: the next change is a new step.
+        if ui.input(|i| i.pointer.any_released()) {
+            actions.push(Action::EndGesture);
+        }
+    }
+
+    fn shortcuts(&mut self, ctx: &egui::Context, frame: &Frame, actions: &mut Vec<Action>) {
+        if ctx.egui_wants_keyboard_input() {
+            return; // typing in a field: its own undo and keys
+        }
+        let redo = [
+            KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z),
+            KeyboardShortcut::new(Modifiers::COMMAND, Key::Y),
+        ];
+        ctx.input_mut(|input| {
+            if redo.iter().any(|s| input.consume_shortcut(s)) {
+                actions.push(Action::Redo);
+            } else if input.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::Z)) {
+                actions.push(Action::Undo);
+            }
+            if input.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::S)) {
+                match frame.session.document.path() {
+                    Some(_) => actions.push(Action::SaveLook(None)),
+                    None => self.file_dialog = Some(FileDialog::new(FilePurpose::SaveLook)),
+                }
+            }
+            if input.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::Q)) {
+                actions.push(Action::Quit);
+            }
+            if input.consume_key(Modifiers::NONE, Key::F) {
+                self.viewport.fit();
+            }
+            if input.consume_key(Modifiers::NONE, Key::Num1) {
+                self.viewport.actual_pixels();
+            }
+        });
+    }
+
+    fn menu(&mut self, ui: &mut egui::Ui, frame: &Frame, actions: &mut Vec<Action>) {
+        let document = &frame.session.document;
+        egui::MenuBar::new().ui(ui, |ui| {
+            ui.menu_button("File", |ui| {
+                if ui.button("Open look…").clicked() {
+                    self.file_dialog = Some(FileDialog::new(FilePurpose::OpenLook));
+                }
+                if ui
+                    .add_enabled(document.path().is_some(), egui::Button::new("Save look").shortcut_text("Ctrl+S"))
+                    .clicked()
+                {
+                    actions.push(Action::SaveLook(None));
+                }
+                if ui.button("Save look as…").clicked() {
+                    self.file_dialog = Some(FileDialog::new(FilePurpose::SaveLook));
+                }
+                ui.separator();
+                let layer_selected = document.selection().layer.is_some();
+                if ui.add_enabled(layer_selected, egui::Button::new("Save layer as preset…")).clicked() {
+                    self.save_preset = Some(dialogs::SavePresetForm::default());
+                }
+                if ui.button("Save image…").clicked() {
+                    self.file_dialog = Some(FileDialog::new(FilePurpose::SaveImage));
+                }
+                ui.separator();
+                if ui.button("Open environment…").clicked() {
+                    self.file_dialog = Some(FileDialog::new(FilePurpose::OpenEnvironment));
+                }
+                ui.separator();
+                if ui.add(egui::Button::new("Quit").shortcut_text("Ctrl+Q")).clicked() {
+                    actions.push(Action::Quit);
+                }
+            });
+            ui.menu_button("Edit", |ui| {
+                if ui.add_enabled(document.can_undo(), egui::Button::new("Undo").shortcut_text("Ctrl+Z")).clicked() {
+                    actions.push(Action::Undo);
+                }
+                let redo = egui::Button::new("Redo").shortcut_text("Ctrl+Shift+Z");
+                if ui.add_enabled(document.can_redo(), redo).clicked() {
+                    actions.push(Action::Redo);
+                }
+                ui.separator();
+                if ui.button("Add layer from library…").clicked() {
+                    self.browser.open = true;
+                }
+            });
+            ui.menu_button("View", |ui| {
+                if ui.add(egui::Button::new("Fit").shortcut_text("F")).clicked() {
+                    self.viewport.fit();
+                }
+                if ui.add(egui::Button::new("Actual pixels (1:1)").shortcut_text("1")).clicked() {
+                    self.viewport.actual_pixels();
+                }
+            });
+            ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+                let name = document.path().map_or("untitled look".to_string(), |p| p.display().to_string());
+                if document.is_dirty() {
+                    ui.label(egui::RichText::new("● unsaved edits").color(ui.visuals().warn_fg_color))
+                        .on_hover_text("The look has changes that are not saved");
+                }
+                ui.label(name);
+            });
+        });
+    }
+
+    fn status(&mut self, ui: &mut egui::Ui, frame: &Frame) {
+        let session = frame.session;
+        ui.horizontal(|ui| {
+            let (samples, target) = (session.samples(), session.target());
+            let state = if samples >= target { "done" } else { "rendering" };
+            ui.label(format!("{samples} / {target} spp ({state})"));
+            ui.separator();
+            ui.label(format!("{:.1} M samples/s", session.progressive.samples_per_second() / 1e6));
+            ui.separator();
+            ui.label(format!("frame {:.1} ms", frame.figures.frame.as_secs_f64() * 1e3));
+            if let Some(first) = session.first_pass_after_change {
+                ui.separator();
+                ui.label(format!("first pass {:.0} ms", first.as_secs_f64() * 1e3))
+                    .on_hover_text("Time from the last change to a first full pass over the image");
+            }
+            ui.separator();
+            ui.label(format!("{}×{} · {}", session.width(), session.height(), session.device_name()));
+            if let Some(message) = &self.message {
+                if message.since.elapsed() < MESSAGE_TIME || message.error {
+                    ui.separator();
+                    let color = if message.error { ui.visuals().error_fg_color } else { ui.visuals().text_color() };
+                    ui.label(egui::RichText::new(&message.text).color(color));
+                }
+            }
+        });
+    }
+}

@@ -1,0 +1,190 @@
+//! The image: fit, zoom about the cursor, pan, 1:1 pixels; Shift+drag turns the light, a click
+//! inspects a pixel and selects its object.
+
+use super::super::action::Action;
+use super::super::session::Session;
+use crate::viewer_state::Edit;
+use egui::{pos2, vec2, Color32, PointerButton, Rect, Sense};
+
+/// Degrees of environment rotation per point dragged: a drag across a typical view is a turn.
+const DEGREES_PER_POINT: f32 = 0.4;
+const MIN_SCALE: f32 = 1.0 / 16.0;
+const MAX_SCALE: f32 = 32.0;
+
+/// How the image sits in the view.
+#[derive(Default)]
+pub struct Viewport {
+    /// Window pixels per image pixel; `None` fits the image to the view, never beyond 1:1.
+    scale: Option<f32>,
+    /// The image centre's offset from the view centre, in points.
+    pan: egui::Vec2,
+    /// A Shift+drag in progress: the rotation it started from and the distance dragged.
+    rotating: Option<(f32, f32)>,
+}
+
+/// Where the image was drawn, in window pixels, for the screenshot report.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImagePlacement {
+    pub x: i32,
+    pub y: i32,
+    pub width: u32,
+    pub height: u32,
+    /// Window pixels per image pixel.
+    pub scale: f32,
+}
+
+impl Viewport {
+    pub fn fit(&mut self) {
+        self.scale = None;
+        self.pan = egui::Vec2::ZERO;
+    }
+
+    pub fn actual_pixels(&mut self) {
+        self.scale = Some(1.0);
+        self.pan = egui::Vec2::ZERO;
+    }
+
+    pub fn show(
+        &mut self,
+        ui: &mut egui::Ui,
+        session: &Session,
+        texture: egui::TextureId,
+        actions: &mut Vec<Action>,
+    ) -> ImagePlacement {
+        let rect = ui.max_rect();
+        let response = ui.allocate_rect(rect, Sense::click_and_drag());
+        let ppp = ui.ctx().pixels_per_point();
+        let (w, h) = (session.width() as f32, session.height() as f32);
+        let fit = (rect.width() * ppp / w).min(rect.height() * ppp / h).min(1.0);
+        let scale = self.scale.unwrap_or(fit);
+        let size = vec2(w, h) * scale / ppp;
+        let centre = rect.center() + self.pan;
+        // On whole window pixels, so that 1:1 shows each image pixel exactly once.
+        let min = ((centre - size / 2.0).to_vec2() * ppp).round() / ppp;
+        let image_rect = Rect::from_min_size(min.to_pos2(), size);
+
+        let painter = ui.painter_at(rect);
+        painter.rect_filled(rect, 0.0, Color32::from_gray(18));
+        painter.image(texture, image_rect, Rect::from_min_max(pos2(0.0, 0.0), pos2(1.0, 1.0)), Color32::WHITE);
+
+        let rotation = session.document.settings().lighting.rotation_degrees;
+        self.interact(ui, &response, rotation, scale, actions);
+        self.zoom(ui, &response, rect, centre, scale);
+        if response.clicked() {
+            if let Some(pixel) = response.interact_pointer_pos().and_then(|p| pixel_at(p, image_rect, w, h)) {
+                actions.push(Action::Pick { x: pixel.0, y: pixel.1 });
+            }
+        }
+        self.overlay(ui, &response, &painter, rect, image_rect, scale, (w, h), rotation);
+        ImagePlacement {
+            x: (image_rect.min.x * ppp).round() as i32,
+            y: (image_rect.min.y * ppp).round() as i32,
+            width: (size.x * ppp).round() as u32,
+            height: (size.y * ppp).round() as u32,
+            scale,
+        }
+    }
+
+    fn interact(
+        &mut self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        rotation: f32,
+        scale: f32,
+        actions: &mut Vec<Action>,
+    ) {
+        let shift = ui.input(|i| i.modifiers.shift);
+        if response.drag_started_by(PointerButton::Primary) && shift {
+            self.rotating = Some((rotation, 0.0));
+        }
+        if let Some((start, distance)) = &mut self.rotating {
+            if response.dragged() {
+                *distance += response.drag_delta().x;
+                actions.push(Action::Drag(Edit::SetRotation(wrap_degrees(*start + *distance * DEGREES_PER_POINT))));
+            }
+            if response.drag_stopped() || !response.dragged() {
+                self.rotating = None;
+                actions.push(Action::EndGesture);
+            }
+        } else if response.dragged_by(PointerButton::Primary) || response.dragged_by(PointerButton::Middle) {
+            // Panning a fitted image keeps its size: fit becomes an explicit zoom.
+            self.scale = Some(scale);
+            self.pan += response.drag_delta();
+        }
+    }
+
+    fn zoom(&mut self, ui: &egui::Ui, response: &egui::Response, rect: Rect, centre: egui::Pos2, scale: f32) {
+        let Some(cursor) = response.hover_pos() else { return };
+        let (scroll, pinch) = ui.input(|i| (i.smooth_scroll_delta.y, i.zoom_delta()));
+        let factor = pinch * (scroll * 0.0025).exp();
+        if (factor - 1.0).abs() < 1e-4 {
+            return;
+        }
+        let new_scale = (scale * factor).clamp(MIN_SCALE, MAX_SCALE);
+        // Keep the image point under the cursor where it is.
+        let new_centre = cursor - (cursor - centre) * (new_scale / scale);
+        self.pan = new_centre - rect.center();
+        self.scale = Some(new_scale);
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn overlay(
+        &self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        painter: &egui::Painter,
+        rect: Rect,
+        image_rect: Rect,
+        scale: f32,
+        (w, h): (f32, f32),
+        rotation: f32,
+    ) {
+        let font = egui::FontId::proportional(13.0);
+        let color = Color32::from_gray(200);
+        if self.rotating.is_some() {
+            painter.text(
+                rect.left_top() + vec2(10.0, 10.0),
+                egui::Align2::LEFT_TOP,
+                format!("light rotation {rotation:.1}°"),
+                egui::FontId::proportional(18.0),
+                Color32::WHITE,
+            );
+        }
+        let zoom = match self.scale {
+            None => format!("fit {:.0}%", scale * 100.0),
+            Some(_) => format!("{:.0}%", scale * 100.0),
+        };
+        let mut corner = zoom;
+        if let Some(pixel) = response.hover_pos().and_then(|p| pixel_at(p, image_rect, w, h)) {
+            corner = format!("{}, {}   {corner}", pixel.0, pixel.1);
+        }
+        painter.text(rect.right_bottom() - vec2(10.0, 8.0), egui::Align2::RIGHT_BOTTOM, corner, font.clone(), color);
+        if response.hovered() && !ui.input(|i| i.pointer.any_down()) {
+            painter.text(
+                rect.left_bottom() + vec2(10.0, -8.0),
+                egui::Align2::LEFT_BOTTOM,
+                "click: inspect · Shift+drag: rotate light · drag: pan · wheel: zoom · F: fit · 1: 1:1",
+                font,
+                Color32::from_gray(130),
+            );
+        }
+    }
+}
+
+/// The image pixel under window point `p`, if it is on the image.
+fn pixel_at(p: egui::Pos2, image_rect: Rect, w: f32, h: f32) -> Option<(u32, u32)> {
+    let u = (p - image_rect.min) / image_rect.size();
+    (0.0..1.0).contains(&u.x).then_some(())?;
+    (0.0..1.0).contains(&u.y).then_some(())?;
+    Some(((u.x * w) as u32, (u.y * h) as u32))
+}
+
+/// Degrees into (−180, 180].
+pub fn wrap_degrees(degrees: f32) -> f32 {
+    let wrapped = (degrees + 180.0).rem_euclid(360.0) - 180.0;
+    if wrapped == -180.0 {
+        180.0
+    } else {
+        wrapped
+    }
+}
