@@ -154,7 +154,10 @@ impl Context {
         Ok((ctx, surface.expect("a surface was asked for")))
     }
 
-    fn create(options: &ContextOptions, presentation: Option<Presentation>) -> Result<(Context, Option<vk::SurfaceKHR>)> {
+    fn create(
+        options: &ContextOptions,
+        presentation: Option<Presentation>,
+    ) -> Result<(Context, Option<vk::SurfaceKHR>)> {
         let entry = unsafe { ash::Entry::load() }
             .map_err(|e| Error::gpu(format!("no Vulkan loader found ({e}); {INSTALL_DRIVER}")))?;
         let counter = Arc::new(ValidationCounter::default());
@@ -355,13 +358,14 @@ fn pick_and_create_device(
         }
         None => true,
     };
-    let (physical_device, queue_family, info) = match choose_physical_device(&instance, options, surface.is_some(), &presents) {
-        Ok(chosen) => chosen,
-        Err(e) => {
-            give_up(&instance, &debug);
-            return Err(e);
-        }
-    };
+    let (physical_device, queue_family, info) =
+        match choose_physical_device(&instance, options, surface.is_some(), &presents) {
+            Ok(chosen) => chosen,
+            Err(e) => {
+                give_up(&instance, &debug);
+                return Err(e);
+            }
+        };
     let priorities = [1.0f32];
     let queue_info =
         [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
@@ -426,7 +430,8 @@ fn candidates(
             continue;
         }
         let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
-        let wanted = if graphics { vk::QueueFlags::COMPUTE | vk::QueueFlags::GRAPHICS } else { vk::QueueFlags::COMPUTE };
+        let wanted =
+            if graphics { vk::QueueFlags::COMPUTE | vk::QueueFlags::GRAPHICS } else { vk::QueueFlags::COMPUTE };
         let Some(family) =
             (0..families.len()).find(|&f| families[f].queue_flags.contains(wanted) && presents(pd, f as u32))
         else {
