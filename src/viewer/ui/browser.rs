@@ -77,7 +77,12 @@ impl Browser {
         let mut open = self.open;
         let mut refresh = false;
         let target = session.document.selection().object.map_or("the default stack".to_string(), |o| o.to_string());
-        egui::Window::new("Preset library").open(&mut open).default_size([600.0, 620.0]).show(ctx, |ui| {
+        let window = egui::Window::new("Preset library")
+            .open(&mut open)
+            .default_size([620.0, 560.0])
+            .default_pos([360.0, 80.0])
+            .resizable(true);
+        window.show(ctx, |ui| {
             ui.horizontal(|ui| {
                 ui.add(egui::TextEdit::singleline(&mut self.search).hint_text("search names, tags, descriptions"));
                 let tags: BTreeSet<&String> = entries.iter().flat_map(|e| &e.tags).collect();
@@ -110,17 +115,22 @@ impl Browser {
                 .collect();
             // One new thumbnail per frame, so the interface stays live while they render.
             let mut may_render = true;
-            egui::ScrollArea::vertical().show(ui, |ui| {
-                ui.horizontal_wrapped(|ui| {
-                    for entry in shown {
-                        let texture = entry.params.as_ref().and_then(|params| {
-                            texture(ctx, &mut self.textures, thumbnails, params, &mut may_render, message)
-                        });
-                        if cell(ui, entry, texture) {
-                            actions.push(Action::AddPresetLayer(entry.name.clone()));
+            egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
+                // Rows of as many cells as fit: a wrapping layout would widen the window instead.
+                let cell_width = thumbnails::SIZE as f32 + 8.0 + ui.spacing().item_spacing.x;
+                let columns = ((ui.available_width() / cell_width) as usize).max(1);
+                for row in shown.chunks(columns) {
+                    ui.horizontal(|ui| {
+                        for entry in row {
+                            let texture = entry.params.as_ref().and_then(|params| {
+                                texture(ctx, &mut self.textures, thumbnails, params, &mut may_render, message)
+                            });
+                            if cell(ui, entry, texture) {
+                                actions.push(Action::AddPresetLayer(entry.name.clone()));
+                            }
                         }
-                    }
-                });
+                    });
+                }
             });
             if !may_render {
                 ctx.request_repaint();
