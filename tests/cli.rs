@@ -227,6 +227,20 @@ fn a_clamped_environment_renders_with_a_warning() {
 }
 
 #[test]
+fn a_stack_for_an_object_the_gbuffer_lacks_is_reported_once() {
+    let ws = Workspace::new();
+    let g = ws.gbuffer(16);
+    let look = ws.file("typo.toml", "[[object]]\nid = 1\n[[object.layer]]\npreset = \"gold\"\n\n[[object]]\nid = 7\n[[object.layer]]\npreset = \"chrome\"\n");
+    let out = ws.arg("o.png");
+    let output = lookdev(&["render", "--gbuffer", &g, "--look", &look, "--spp", "1", "--quiet", "--out", &out]);
+    assert_success(&output);
+    let warnings: Vec<String> =
+        stderr(&output).lines().filter(|l| l.contains("object id 7")).map(String::from).collect();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(warnings[0].contains("typo.toml:8: object id 7 is not in the g-buffer"), "{}", warnings[0]);
+}
+
+#[test]
 fn a_missing_vulkan_driver_names_the_package() {
     let ws = Workspace::new();
     let output = Command::new(env!("CARGO_BIN_EXE_lookdev"))
