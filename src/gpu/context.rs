@@ -16,13 +16,15 @@ pub struct ContextOptions {
     pub device_name: Option<String>,
     /// Enable the Khronos validation layer (with synchronisation validation) and count errors.
     pub validation: bool,
+    /// The queue must also draw (rasterize), with dynamic rendering: for baking g-buffers.
+    pub graphics: bool,
 }
 
 impl ContextOptions {
     /// Validation follows the `LOOKDEV_VALIDATION` environment variable (`1` turns it on).
     pub fn from_env(device_name: Option<String>) -> ContextOptions {
         let validation = std::env::var("LOOKDEV_VALIDATION").is_ok_and(|v| v == "1");
-        ContextOptions { device_name, validation }
+        ContextOptions { device_name, validation, graphics: false }
     }
 }
 
@@ -359,7 +361,7 @@ fn pick_and_create_device(
         None => true,
     };
     let (physical_device, queue_family, info) =
-        match choose_physical_device(&instance, options, surface.is_some(), &presents) {
+        match choose_physical_device(&instance, options, options.graphics || surface.is_some(), &presents) {
             Ok(chosen) => chosen,
             Err(e) => {
                 give_up(&instance, &debug);
@@ -370,9 +372,10 @@ fn pick_and_create_device(
     let queue_info =
         [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
     // glslang's Vulkan 1.3 SPIR-V declares workgroup sizes with LocalSizeId, which needs maintenance4
-    // (core in 1.3 and supported by every 1.3 driver). A window also needs dynamic rendering.
-    let mut features13 =
-        vk::PhysicalDeviceVulkan13Features::default().maintenance4(true).dynamic_rendering(surface.is_some());
+    // (core in 1.3 and supported by every 1.3 driver). Drawing (a window, a bake) also needs
+    // dynamic rendering.
+    let draws = options.graphics || surface.is_some();
+    let mut features13 = vk::PhysicalDeviceVulkan13Features::default().maintenance4(true).dynamic_rendering(draws);
     let extensions: Vec<*const std::ffi::c_char> =
         if surface.is_some() { vec![ash::khr::swapchain::NAME.as_ptr()] } else { Vec::new() };
     let device_info = vk::DeviceCreateInfo::default()

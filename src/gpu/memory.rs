@@ -2,8 +2,9 @@
 //!
 //! lookdev makes a few dozen long-lived, mostly large resources, far below any driver's
 //! allocation-count limit, so one allocation per resource is the simplest correct scheme.
-//! Images live in the GENERAL layout for their whole life: they are only ever used by compute
-//! kernels and transfers.
+//! Images live in the GENERAL layout for their whole life, whatever they are used for (compute
+//! kernels, transfers, sampling, or as the bake's render targets), so no pass ever has to track
+//! layouts.
 
 use super::context::{Context, Shared};
 use crate::{Error, Result};
@@ -34,7 +35,7 @@ fn allocate(shared: &Shared, requirements: vk::MemoryRequirements, host_visible:
         .map_err(|e| Error::gpu(format!("cannot allocate {} MiB of GPU memory ({e})", requirements.size >> 20)))
 }
 
-/// A storage or staging buffer.
+/// A storage, staging or vertex buffer.
 pub struct Buffer {
     shared: Arc<Shared>,
     pub buffer: vk::Buffer,
@@ -110,6 +111,20 @@ impl Buffer {
         Ok(buffer)
     }
 
+    /// A device-local vertex buffer holding `data`.
+    pub fn vertices(ctx: &Context, data: &[u8]) -> Result<Buffer> {
+        let usage = vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+        let buffer = Buffer::new(ctx, data.len() as u64, usage, false)?;
+        let mut staging = Buffer::staging(ctx, data.len() as u64)?;
+        staging.bytes_mut()[..data.len()].copy_from_slice(data);
+        ctx.run(|cmd| {
+            let region = vk::BufferCopy::default().size(data.len().max(1) as u64);
+            unsafe { ctx.device.cmd_copy_buffer(cmd, staging.buffer, buffer.buffer, &[region]) };
+            Ok(())
+        })?;
+        Ok(buffer)
+    }
+
     /// Copies the whole buffer back to the host.
     pub fn read(&self, ctx: &Context) -> Result<Vec<u8>> {
         let staging = Buffer::staging(ctx, self.size)?;
@@ -134,7 +149,42 @@ impl Drop for Buffer {
     }
 }
 
-/// A 2D storage image (optionally an array), always in the GENERAL layout.
+/// What an image is for, which decides its usage flags.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Purpose {
+    /// Read and written by kernels, filled and read back by transfers.
+    Storage,
+    /// RGBA8 display pixels that kernels write and the viewer samples as sRGB.
+    Display,
+    /// A colour target of the bake's render pass, read back by transfers.
+    ColorTarget,
+    /// The depth buffer of the bake's render pass.
+    DepthTarget,
+    /// A texture the bake's shaders sample, filled by a transfer.
+    Texture,
+}
+
+impl Purpose {
+    fn usage(self) -> vk::ImageUsageFlags {
+        let transfer = vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
+        match self {
+            Purpose::Storage => vk::ImageUsageFlags::STORAGE | transfer,
+            Purpose::Display => vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::SAMPLED | transfer,
+            Purpose::ColorTarget => vk::ImageUsageFlags::COLOR_ATTACHMENT | transfer,
+            Purpose::DepthTarget => vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+            Purpose::Texture => vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+        }
+    }
+
+    fn aspect(self) -> vk::ImageAspectFlags {
+        match self {
+            Purpose::DepthTarget => vk::ImageAspectFlags::DEPTH,
+            _ => vk::ImageAspectFlags::COLOR,
+        }
+    }
+}
+
+/// A 2D image (optionally an array), always in the GENERAL layout.
 pub struct Image {
     shared: Arc<Shared>,
     pub image: vk::Image,
@@ -146,13 +196,15 @@ pub struct Image {
     pub width: u32,
     pub height: u32,
     pub layers: u32,
+    aspect: vk::ImageAspectFlags,
 }
 
 /// Bytes per texel of the formats lookdev uses.
 pub fn texel_size(format: vk::Format) -> u64 {
     match format {
         vk::Format::R32G32B32A32_SFLOAT => 16,
-        vk::Format::R32_SFLOAT | vk::Format::R32_UINT | vk::Format::R8G8B8A8_UNORM => 4,
+        vk::Format::R32G32_SFLOAT | vk::Format::R32G32_UINT => 8,
+        vk::Format::R32_SFLOAT | vk::Format::R32_UINT | vk::Format::R8G8B8A8_UNORM | vk::Format::D32_SFLOAT => 4,
         other => panic!("texel_size: format {other:?} is not used by lookdev"),
     }
 }
@@ -160,13 +212,30 @@ pub fn texel_size(format: vk::Format) -> u64 {
 impl Image {
     /// A storage image of `layers` layers (a 2D array view when `layers` > 1 or `array` is set).
     pub fn new(ctx: &Context, format: vk::Format, width: u32, height: u32, layers: u32, array: bool) -> Result<Image> {
-        Image::create(ctx, format, width, height, layers, array, false)
+        Image::create(ctx, format, width, height, layers, array, Purpose::Storage)
     }
 
     /// An RGBA8 storage image holding sRGB-encoded display pixels, which can also be sampled
     /// through [`Image::srgb_view`] (the viewer shows it that way).
     pub fn display(ctx: &Context, width: u32, height: u32) -> Result<Image> {
-        Image::create(ctx, vk::Format::R8G8B8A8_UNORM, width, height, 1, false, true)
+        Image::create(ctx, vk::Format::R8G8B8A8_UNORM, width, height, 1, false, Purpose::Display)
+    }
+
+    /// A colour render target whose pixels transfers can read back.
+    pub fn color_target(ctx: &Context, format: vk::Format, width: u32, height: u32) -> Result<Image> {
+        Image::create(ctx, format, width, height, 1, false, Purpose::ColorTarget)
+    }
+
+    /// A 32-bit float depth buffer.
+    pub fn depth_target(ctx: &Context, width: u32, height: u32) -> Result<Image> {
+        Image::create(ctx, vk::Format::D32_SFLOAT, width, height, 1, false, Purpose::DepthTarget)
+    }
+
+    /// A sampled RGBA8 texture (linear values: no sRGB decoding) holding `rgba`.
+    pub fn texture(ctx: &Context, width: u32, height: u32, rgba: &[u8]) -> Result<Image> {
+        let image = Image::create(ctx, vk::Format::R8G8B8A8_UNORM, width, height, 1, false, Purpose::Texture)?;
+        image.upload(ctx, rgba)?;
+        Ok(image)
     }
 
     fn create(
@@ -176,16 +245,15 @@ impl Image {
         height: u32,
         layers: u32,
         array: bool,
-        sampled_as_srgb: bool,
+        purpose: Purpose,
     ) -> Result<Image> {
+        let sampled_as_srgb = purpose == Purpose::Display;
         let max = ctx.info().max_image_dimension_2d;
         if width == 0 || height == 0 || width > max || height > max {
             return Err(Error::gpu(format!(
                 "a {width}x{height} image is outside what this device supports (1 to {max} pixels a side)"
             )));
         }
-        let usage =
-            vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
@@ -194,7 +262,7 @@ impl Image {
             .array_layers(layers)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
-            .usage(if sampled_as_srgb { usage | vk::ImageUsageFlags::SAMPLED } else { usage })
+            .usage(purpose.usage())
             .flags(if sampled_as_srgb { vk::ImageCreateFlags::MUTABLE_FORMAT } else { vk::ImageCreateFlags::empty() })
             .sharing_mode(vk::SharingMode::EXCLUSIVE)
             .initial_layout(vk::ImageLayout::UNDEFINED);
@@ -210,6 +278,7 @@ impl Image {
             width,
             height,
             layers,
+            aspect: purpose.aspect(),
         };
         let device = &result.shared.device;
         let requirements = unsafe { device.get_image_memory_requirements(image) };
@@ -220,7 +289,7 @@ impl Image {
             .image(image)
             .view_type(view_type)
             .format(format)
-            .subresource_range(Image::range(layers));
+            .subresource_range(result.range());
         result.view = unsafe { device.create_image_view(&view_info, None) }?;
         if sampled_as_srgb {
             // sRGB formats cannot be storage images: this view is for sampling only.
@@ -235,8 +304,8 @@ impl Image {
         Ok(result)
     }
 
-    fn range(layers: u32) -> vk::ImageSubresourceRange {
-        vk::ImageSubresourceRange::default().aspect_mask(vk::ImageAspectFlags::COLOR).level_count(1).layer_count(layers)
+    fn range(&self) -> vk::ImageSubresourceRange {
+        vk::ImageSubresourceRange::default().aspect_mask(self.aspect).level_count(1).layer_count(self.layers)
     }
 
     fn transition_to_general(&self, cmd: vk::CommandBuffer) {
@@ -248,7 +317,7 @@ impl Image {
             .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .image(self.image)
-            .subresource_range(Image::range(self.layers));
+            .subresource_range(self.range());
         unsafe {
             self.shared.device.cmd_pipeline_barrier(
                 cmd,
@@ -270,7 +339,7 @@ impl Image {
                 self.image,
                 vk::ImageLayout::GENERAL,
                 &vk::ClearColorValue::default(),
-                &[Image::range(self.layers)],
+                &[self.range()],
             )
         };
     }
@@ -281,9 +350,7 @@ impl Image {
 
     fn copy_region(&self) -> vk::BufferImageCopy {
         vk::BufferImageCopy::default()
-            .image_subresource(
-                vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(self.layers),
-            )
+            .image_subresource(vk::ImageSubresourceLayers::default().aspect_mask(self.aspect).layer_count(self.layers))
             .image_extent(vk::Extent3D { width: self.width, height: self.height, depth: 1 })
     }
 
@@ -315,6 +382,20 @@ impl Image {
                 vk::ImageLayout::GENERAL,
                 staging.buffer,
                 &[self.copy_region()],
+            )
+        };
+    }
+
+    /// Records a copy of the whole image into `staging` from byte `offset` on.
+    pub fn record_read_at(&self, cmd: vk::CommandBuffer, staging: &Buffer, offset: u64) {
+        let region = self.copy_region().buffer_offset(offset);
+        unsafe {
+            self.shared.device.cmd_copy_image_to_buffer(
+                cmd,
+                self.image,
+                vk::ImageLayout::GENERAL,
+                staging.buffer,
+                &[region],
             )
         };
     }

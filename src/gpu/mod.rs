@@ -1,7 +1,9 @@
 //! The Vulkan layer: one [`Context`] (instance, device, queue, memory), buffers and images,
-//! compute pipelines built from the committed SPIR-V, and GPU timestamps.
+//! compute pipelines built from the committed SPIR-V, the bake's graphics pipeline, and GPU
+//! timestamps.
 
 pub mod context;
+pub mod graphics;
 pub mod memory;
 pub mod pipeline;
 pub mod shaders;

@@ -1,5 +1,6 @@
-//! The compute kernels, compiled from `glsl/` and committed in `spirv/`, so that a clean checkout
-//! builds without a shader compiler. `tests/spirv.rs` checks that the committed SPIR-V is current.
+//! The compute kernels and the bake's graphics shaders, compiled from `glsl/` and committed in
+//! `spirv/`, so that a clean checkout builds without a shader compiler. `tests/spirv.rs` checks
+//! that the committed SPIR-V is current.
 
 /// One compute kernel's SPIR-V.
 pub struct Kernel {
@@ -26,3 +27,23 @@ pub const SAMPLE_PROBE: Kernel = kernel!("sample_probe");
 
 /// Every kernel, with the GLSL file it is compiled from (`glsl/<name>.comp`).
 pub const ALL: [&Kernel; 5] = [&RESOLVE, &RELIGHT, &FINALIZE, &BRDF_PROBE, &SAMPLE_PROBE];
+
+/// One graphics shader stage's SPIR-V, compiled from `glsl/<file>`.
+pub struct Stage {
+    pub file: &'static str,
+    pub spirv: &'static [u8],
+}
+
+macro_rules! stage {
+    ($file:literal) => {
+        Stage { file: $file, spirv: include_bytes!(concat!("../../spirv/", $file, ".spv")) }
+    };
+}
+
+/// The bake's vertex stage: world-space vertices to clip space.
+pub const BAKE_VERTEX: Stage = stage!("bake.vert");
+/// The bake's fragment stage: one g-buffer sample of the nearest surface.
+pub const BAKE_FRAGMENT: Stage = stage!("bake.frag");
+
+/// Every graphics stage.
+pub const STAGES: [&Stage; 2] = [&BAKE_VERTEX, &BAKE_FRAGMENT];
