@@ -11,14 +11,24 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn kernels() -> Vec<PathBuf> {
+/// The GLSL files with the given extensions (`comp`: kernels; `vert`, `frag`: graphics stages).
+fn shaders(extensions: &[&str]) -> Vec<PathBuf> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(root().join("glsl"))
         .unwrap()
         .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "comp"))
+        .filter(|p| p.extension().is_some_and(|e| extensions.iter().any(|x| e == *x)))
         .collect();
     files.sort();
     files
+}
+
+fn kernels() -> Vec<PathBuf> {
+    shaders(&["comp"])
+}
+
+/// Every shader that is compiled: the kernels and the graphics stages.
+fn all_shaders() -> Vec<PathBuf> {
+    shaders(&["comp", "vert", "frag"])
 }
 
 /// Whether a tool is installed. In CI (`CI` set) a missing tool is a failure, not a skip: the
@@ -43,8 +53,13 @@ fn every_kernel_is_registered_and_committed() {
     for name in &registered {
         assert!(names.iter().any(|n| n == name), "gpu::shaders::ALL lists {name}, but glsl/{name}.comp is missing");
     }
-    for kernel in kernels() {
-        assert!(spirv_path(&kernel).is_file(), "{} has no committed SPIR-V", kernel.display());
+    let files: Vec<String> =
+        shaders(&["vert", "frag"]).iter().map(|s| s.file_name().unwrap().to_string_lossy().into_owned()).collect();
+    let mut stages: Vec<&str> = lookdev::gpu::shaders::STAGES.iter().map(|s| s.file).collect();
+    stages.sort_unstable();
+    assert_eq!(files, stages, "gpu::shaders::STAGES must list every glsl/*.vert and *.frag");
+    for shader in all_shaders() {
+        assert!(spirv_path(&shader).is_file(), "{} has no committed SPIR-V", shader.display());
     }
 }
 
@@ -58,7 +73,7 @@ fn committed_spirv_matches_the_glsl() {
     let out_dir = std::env::temp_dir().join(format!("lookdev-spirv-{}", std::process::id()));
     std::fs::create_dir_all(&out_dir).unwrap();
     let mut stale = Vec::new();
-    for kernel in kernels() {
+    for kernel in all_shaders() {
         let out = out_dir.join(spirv_path(&kernel).file_name().unwrap());
         // The exact command the committed files come from.
         let status = Command::new("glslangValidator")
@@ -91,7 +106,7 @@ fn committed_spirv_validates() {
         eprintln!("note: spirv-val is not installed (Debian: spirv-tools); SPIR-V not validated");
         return;
     }
-    for kernel in kernels() {
+    for kernel in all_shaders() {
         let output =
             Command::new("spirv-val").args(["--target-env", "vulkan1.3"]).arg(spirv_path(&kernel)).output().unwrap();
         assert!(output.status.success(), "{}: {}", kernel.display(), String::from_utf8_lossy(&output.stderr));

@@ -1,0 +1,30 @@
+#version 460
+// The bake's vertex stage: world-space vertices (flattened and transformed on the CPU) to clip
+// space. Everything else passes through to the fragment stage.
+#extension GL_GOOGLE_include_directive : require
+
+#include "bake_draw.glsl"
+
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+layout(location = 2) in vec4 tangent;     // xyz, w = bitangent sign (glTF)
+layout(location = 3) in vec2 uv0;
+layout(location = 4) in vec2 uv1;
+layout(location = 5) in vec4 color;       // COLOR_0, or white
+
+layout(location = 0) out vec3 world_position;
+layout(location = 1) out vec3 world_normal;
+layout(location = 2) out vec4 world_tangent;
+layout(location = 3) out vec2 out_uv0;
+layout(location = 4) out vec2 out_uv1;
+layout(location = 5) out vec4 out_color;
+
+void main() {
+    world_position = position;
+    world_normal = normal;
+    world_tangent = tangent;
+    out_uv0 = uv0;
+    out_uv1 = uv1;
+    out_color = color;
+    gl_Position = draw.view_projection * vec4(position, 1.0);
+}
