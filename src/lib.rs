@@ -5,6 +5,7 @@
 //! out as images. [`viewer_state`] is the document the interactive viewer edits, with undo and
 //! saving; it needs no GPU. `viewer` (the default `viewer` feature) is the window around it.
 
+pub mod asset;
 pub mod atomic_file;
 pub mod cli;
 pub mod environment;

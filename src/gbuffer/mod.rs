@@ -61,6 +61,7 @@ mod shaderball;
 mod validate;
 mod write;
 
+pub(crate) use frame::orthogonalize;
 pub use frame::stable_tangent;
 /// Object ids of the built-in scene.
 pub use scene::{BALL_ID, PEDESTAL_ID};

@@ -1,0 +1,229 @@
+//! glTF 2.0 assets: read and checked ([`Asset::load`]), flattened into world-space triangles
+//! ([`geometry`]), seen through a camera ([`camera`]), rasterized into a g-buffer ([`bake`]), and
+//! their materials mapped onto the Disney parameters ([`materials`]) and written out as presets
+//! and a look ([`import`]).
+//!
+//! Reading checks everything the later steps rely on, so they can index freely: the JSON is
+//! validated, every buffer and every image a material uses is present and decodes, and the
+//! extensions the file requires are ones lookdev reads. Mesh compression (Draco, meshopt) is
+//! refused by name.
+
+pub mod bake;
+pub mod camera;
+pub mod geometry;
+pub mod import;
+pub mod materials;
+mod names;
+
+pub use names::channel_name;
+
+use crate::{Error, Result};
+use base64::Engine;
+use image::RgbaImage;
+use std::path::{Path, PathBuf};
+
+/// Extensions lookdev reads, for the bake or the material import.
+pub const SUPPORTED_EXTENSIONS: [&str; 5] = [
+    "KHR_materials_ior",
+    "KHR_materials_specular",
+    "KHR_materials_clearcoat",
+    "KHR_materials_sheen",
+    "KHR_materials_anisotropy",
+];
+
+/// Mesh compression extensions, which lookdev cannot decode.
+const COMPRESSION: [(&str, &str); 3] = [
+    ("KHR_draco_mesh_compression", "Draco mesh compression"),
+    ("EXT_meshopt_compression", "meshopt compression"),
+    ("KHR_meshopt_compression", "meshopt compression"),
+];
+
+/// A glTF asset with its buffers and images, checked.
+pub struct Asset {
+    pub path: PathBuf,
+    pub document: gltf::Document,
+    pub buffers: Vec<Vec<u8>>,
+    /// Decoded images by index, RGBA8 as stored (sRGB-encoded colour, linear data); `None` for
+    /// an image no material uses.
+    pub images: Vec<Option<RgbaImage>>,
+}
+
+impl Asset {
+    /// Reads a `.gltf` (with its external or embedded buffers and images) or a `.glb`.
+    pub fn load(path: &Path) -> Result<Asset> {
+        let bytes = std::fs::read(path).map_err(|e| Error::input_file(path, format!("cannot read ({e})")))?;
+        let gltf = gltf::Gltf::from_slice_without_validation(&bytes)
+            .map_err(|e| Error::input_file(path, format!("not a readable glTF file ({e})")))?;
+        let blob = gltf.blob;
+        check_required_extensions(path, &gltf.document)?;
+        // Required extensions are checked above; everything else is validated as usual.
+        let mut json = gltf.document.into_json();
+        json.extensions_required.clear();
+        let document = gltf::Document::from_json(json)
+            .map_err(|e| Error::input_file(path, format!("not a valid glTF file ({})", one_line(&e.to_string()))))?;
+        let folder = path.parent().unwrap_or(Path::new(""));
+        let buffers = document
+            .buffers()
+            .map(|buffer| load_buffer(path, folder, &buffer, blob.as_deref()))
+            .collect::<Result<Vec<_>>>()?;
+        let mut asset = Asset { path: path.to_path_buf(), document, buffers, images: Vec::new() };
+        asset.images = asset.load_images(folder)?;
+        Ok(asset)
+    }
+
+    /// The images materials use, decoded.
+    fn load_images(&self, folder: &Path) -> Result<Vec<Option<RgbaImage>>> {
+        let mut used = vec![false; self.document.images().len()];
+        for material in self.document.materials() {
+            let pbr = material.pbr_metallic_roughness();
+            let textures = [
+                pbr.base_color_texture().map(|t| t.texture()),
+                pbr.metallic_roughness_texture().map(|t| t.texture()),
+                material.normal_texture().map(|t| t.texture()),
+            ];
+            for texture in textures.into_iter().flatten() {
+                used[texture.source().index()] = true;
+            }
+        }
+        self.document
+            .images()
+            .map(|image| match used[image.index()] {
+                true => self.load_image(folder, &image).map(Some),
+                false => Ok(None),
+            })
+            .collect()
+    }
+
+    fn load_image(&self, folder: &Path, image: &gltf::Image) -> Result<RgbaImage> {
+        let label = match image.name() {
+            Some(name) => format!("image {} '{name}'", image.index()),
+            None => format!("image {}", image.index()),
+        };
+        let bytes: Vec<u8> = match image.source() {
+            gltf::image::Source::View { view, .. } => {
+                let buffer = &self.buffers[view.buffer().index()];
+                let range = view.offset()..view.offset() + view.length();
+                buffer
+                    .get(range)
+                    .ok_or_else(|| {
+                        Error::input_file(&self.path, format!("{label}: its buffer view runs past the buffer"))
+                    })?
+                    .to_vec()
+            }
+            gltf::image::Source::Uri { uri, .. } => read_uri(&self.path, folder, uri, &label)?,
+        };
+        let decoded = image::load_from_memory(&bytes)
+            .map_err(|e| Error::input_file(&self.path, format!("{label} cannot be decoded ({e})")))?;
+        Ok(decoded.into_rgba8())
+    }
+
+    /// The decoded image a texture shows.
+    pub fn texture_image(&self, texture: &gltf::Texture) -> &RgbaImage {
+        self.images[texture.source().index()].as_ref().expect("every image a material uses is loaded")
+    }
+
+    /// The extensions the file uses that lookdev ignores, each with what uses it: reported, so
+    /// that nothing is dropped silently.
+    pub fn unsupported_extensions(&self) -> Vec<String> {
+        self.document
+            .extensions_used()
+            .filter(|name| !SUPPORTED_EXTENSIONS.contains(name))
+            .map(|name| name.to_string())
+            .collect()
+    }
+}
+
+fn check_required_extensions(path: &Path, document: &gltf::Document) -> Result<()> {
+    for required in document.extensions_required() {
+        if let Some((_, what)) = COMPRESSION.iter().find(|(name, _)| *name == required) {
+            return Err(Error::input_file(
+                path,
+                format!(
+                    "the meshes use {what} ({required}), which is not supported: lookdev does not decode \
+                     compressed meshes; export the asset without mesh compression"
+                ),
+            ));
+        }
+        if !SUPPORTED_EXTENSIONS.contains(&required) {
+            return Err(Error::input_file(
+                path,
+                format!("the asset requires the extension {required}, which lookdev does not support"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn load_buffer(path: &Path, folder: &Path, buffer: &gltf::Buffer, blob: Option<&[u8]>) -> Result<Vec<u8>> {
+    let label = match buffer.name() {
+        Some(name) => format!("buffer {} '{name}'", buffer.index()),
+        None => format!("buffer {}", buffer.index()),
+    };
+    let data = match buffer.source() {
+        gltf::buffer::Source::Bin => blob
+            .ok_or_else(|| Error::input_file(path, format!("{label} is the binary chunk, but the file has none")))?
+            .to_vec(),
+        gltf::buffer::Source::Uri(uri) => read_uri(path, folder, uri, &label)?,
+    };
+    if data.len() < buffer.length() {
+        return Err(Error::input_file(
+            path,
+            format!("{label} holds {} bytes, fewer than the {} the file declares", data.len(), buffer.length()),
+        ));
+    }
+    Ok(data)
+}
+
+/// The bytes a URI names: embedded base64 data, or a file relative to the asset.
+fn read_uri(path: &Path, folder: &Path, uri: &str, label: &str) -> Result<Vec<u8>> {
+    if let Some(data) = uri.strip_prefix("data:") {
+        let (_, encoded) = data
+            .split_once(";base64,")
+            .ok_or_else(|| Error::input_file(path, format!("{label}: only base64 data URIs are supported")))?;
+        return base64::engine::general_purpose::STANDARD
+            .decode(encoded)
+            .map_err(|e| Error::input_file(path, format!("{label}: its embedded data is not valid base64 ({e})")));
+    }
+    if uri.contains("://") {
+        return Err(Error::input_file(path, format!("{label}: '{uri}' is not a local file")));
+    }
+    let file = folder.join(percent_decode(uri));
+    std::fs::read(&file).map_err(|e| Error::input_file(path, format!("{label}: cannot read {} ({e})", file.display())))
+}
+
+/// URIs escape spaces and other characters as %XX.
+fn percent_decode(uri: &str) -> String {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = bytes.get(i + 1..i + 3).and_then(|h| std::str::from_utf8(h).ok());
+        match (bytes[i], hex.and_then(|h| u8::from_str_radix(h, 16).ok())) {
+            (b'%', Some(byte)) => {
+                out.push(byte);
+                i += 3;
+            }
+            (byte, _) => {
+                out.push(byte);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+fn one_line(text: &str) -> String {
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uris_are_percent_decoded() {
+        assert_eq!(percent_decode("my%20model.bin"), "my model.bin");
+        assert_eq!(percent_decode("100%"), "100%");
+        assert_eq!(percent_decode("a%2Fb%zz"), "a/b%zz");
+    }
+}
