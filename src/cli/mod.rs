@@ -1,7 +1,9 @@
-//! The command line: `lookdev render | gbuffer | presets | wedge | turntable | view | lint | bench | devices`.
+//! The command line: `lookdev render | gbuffer | bake | import | presets | wedge | turntable | view | lint | bench | devices`.
 
+mod bake;
 mod bench;
 mod gbuffer;
+mod import;
 mod inputs;
 mod lint;
 mod presets;
@@ -30,6 +32,11 @@ pub enum Command {
     Render(render::RenderArgs),
     /// Write the built-in look-dev g-buffer to an EXR.
     Gbuffer(gbuffer::GbufferArgs),
+    /// Rasterize a glTF asset into a g-buffer: normals, tangents, view vectors, ids and masks.
+    Bake(bake::BakeArgs),
+    /// Write a glTF asset's materials as presets, and a look that layers them through the
+    /// bake's masks.
+    Import(import::ImportArgs),
     /// The preset library: list, show, save, and a contact sheet of every preset.
     Presets(presets::PresetsArgs),
     /// Render a look once per value of a parameter, as labelled rows.
@@ -70,6 +77,8 @@ pub fn run(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<()> {
     match cli.command {
         Command::Render(args) => render::run(args),
         Command::Gbuffer(args) => gbuffer::run(args),
+        Command::Bake(args) => bake::run(args),
+        Command::Import(args) => import::run(args),
         Command::Presets(args) => presets::run(args),
         Command::Wedge(args) => wedge::run(args),
         Command::Turntable(args) => turntable::run(args),

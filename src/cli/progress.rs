@@ -8,14 +8,22 @@ const SHOW_AFTER: Duration = Duration::from_secs(1);
 pub struct Progress {
     total: u64,
     label: String,
+    /// What is counted, e.g. "spp".
+    unit: &'static str,
     quiet: bool,
     start: Instant,
     bar: Option<ProgressBar>,
 }
 
 impl Progress {
+    /// A bar counting samples per pixel.
     pub fn new(total: u64, label: impl Into<String>, quiet: bool) -> Progress {
-        Progress { total, label: label.into(), quiet, start: Instant::now(), bar: None }
+        Progress::counting(total, label, "spp", quiet)
+    }
+
+    /// A bar counting `unit`s.
+    pub fn counting(total: u64, label: impl Into<String>, unit: &'static str, quiet: bool) -> Progress {
+        Progress { total, label: label.into(), unit, quiet, start: Instant::now(), bar: None }
     }
 
     /// Reports `done` of `total`; the bar appears once the work has run for a second.
@@ -26,9 +34,12 @@ impl Progress {
         if self.bar.is_none() && self.start.elapsed() >= SHOW_AFTER && done < self.total {
             let bar = ProgressBar::new(self.total);
             bar.set_style(
-                ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} spp, {elapsed} elapsed, eta {eta}")
-                    .expect("the template is valid")
-                    .progress_chars("=> "),
+                ProgressStyle::with_template(&format!(
+                    "{{msg}} [{{bar:40}}] {{pos}}/{{len}} {}, {{elapsed}} elapsed, eta {{eta}}",
+                    self.unit
+                ))
+                .expect("the template is valid")
+                .progress_chars("=> "),
             );
             bar.set_message(self.label.clone());
             self.bar = Some(bar);

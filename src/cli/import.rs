@@ -1,0 +1,51 @@
+//! `lookdev import`: a glTF asset's materials as presets and a look.
+
+use crate::asset::import::Import;
+use crate::asset::Asset;
+use crate::Result;
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct ImportArgs {
+    /// The asset: a .gltf (with its buffers and images) or a .glb.
+    #[arg(value_name = "MODEL.gltf|.glb")]
+    pub model: PathBuf,
+    /// The folder the presets are written to, one `<material>.toml` each (created if needed).
+    #[arg(long, value_name = "DIR")]
+    pub presets: PathBuf,
+    /// The look that layers the presets through the bake's masks.
+    #[arg(long, value_name = "LOOK.toml")]
+    pub look: PathBuf,
+    /// Replace presets and a look that already exist.
+    #[arg(long)]
+    pub force: bool,
+    /// No summary.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+pub fn run(args: ImportArgs) -> Result<()> {
+    let asset = Asset::load(&args.model)?;
+    let import = Import::new(&asset)?;
+    if !import.unsupported.is_empty() {
+        crate::warn(format!(
+            "{}: ignoring unsupported extensions: {}",
+            args.model.display(),
+            import.unsupported.join(", ")
+        ));
+    }
+    let written = import.write(&asset, &args.presets, &args.look, args.force)?;
+    if !args.quiet {
+        for material in &import.materials {
+            let notes = if material.mapped.notes.is_empty() {
+                String::new()
+            } else {
+                format!(": {}", material.mapped.notes.join("; "))
+            };
+            eprintln!("lookdev: '{}' -> preset {}{notes}", material.used.label, material.preset.name);
+        }
+        eprintln!("lookdev: wrote {} files, the look {}", written.len(), args.look.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,600 @@
+//! Baking glTF assets into g-buffers and importing their materials, checked against analytic
+//! geometry, the material mapping's formulas and the built-in analytic sphere. Every bake runs
+//! with Vulkan validation on and fails on any error.
+
+mod common;
+
+use common::gltf::{camera_looking_down_z, cube, plane, uv_sphere, Gltf, Mesh};
+use glam::{Mat3, Quat, Vec3};
+use lookdev::asset::bake::{bake, BakeOptions};
+use lookdev::asset::camera::CameraChoice;
+use lookdev::asset::import::Import;
+use lookdev::asset::Asset;
+use lookdev::gbuffer::GBuffer;
+use serde_json::json;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bake_file(path: &Path, size: u32, samples: u32) -> GBuffer {
+    let ctx = common::gpu::graphics_context();
+    let asset = Asset::load(path).unwrap_or_else(|e| panic!("{e}"));
+    let options = BakeOptions { width: size, height: size, samples, camera: CameraChoice::Default };
+    let gbuffer = bake(&ctx, &asset, &options, |_, _, _| {}).unwrap_or_else(|e| panic!("{e}"));
+    common::gpu::finish(ctx);
+    gbuffer
+}
+
+/// The ray through the centre of pixel (x, y) (plus a sub-pixel offset) of a camera at `eye`
+/// looking down −Z with +Y up and a square frame.
+fn ray(eye: Vec3, fov_degrees: f32, size: u32, x: f32, y: f32) -> (Vec3, Vec3) {
+    let half = (fov_degrees.to_radians() / 2.0).tan();
+    let ndc = |c: f32| 2.0 * c / size as f32 - 1.0;
+    (eye, Vec3::new(ndc(x) * half, -ndc(y) * half, -1.0).normalize())
+}
+
+fn angle_degrees(a: Vec3, b: Vec3) -> f32 {
+    a.normalize().dot(b.normalize()).clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// The scene of the first test: a sphere on the left, and on the right a cube turned 30° about
+/// Y and 20° about X, scaled by 1.5 and mirrored in x (a negative scale, which turns its
+/// triangles' winding around).
+struct TwoObjects {
+    sphere_centre: Vec3,
+    cube_centre: Vec3,
+    /// Cube space to world: rotation times the mirroring scale (half-size 0.5 before scaling).
+    cube_linear: Mat3,
+    eye: Vec3,
+    fov: f32,
+}
+
+const SPHERE_RADIUS: f32 = 1.0;
+
+impl TwoObjects {
+    fn new() -> TwoObjects {
+        let rotation = Quat::from_rotation_y(30f32.to_radians()) * Quat::from_rotation_x(20f32.to_radians());
+        TwoObjects {
+            sphere_centre: Vec3::new(-1.3, 0.0, 0.0),
+            cube_centre: Vec3::new(1.3, 0.1, 0.0),
+            cube_linear: Mat3::from_quat(rotation) * Mat3::from_diagonal(Vec3::new(-1.5, 1.5, 1.5)),
+            eye: Vec3::new(0.0, 0.0, 9.0),
+            fov: 30.0,
+        }
+    }
+
+    fn write(&self, dir: &Path) -> PathBuf {
+        let mut gltf = Gltf::new();
+        let paint = gltf.material(json!({
+            "name": "red paint",
+            "pbrMetallicRoughness": { "baseColorFactor": [0.8, 0.1, 0.1, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.4 }
+        }));
+        let steel = gltf.material(json!({
+            "name": "steel",
+            "pbrMetallicRoughness": { "baseColorFactor": [0.6, 0.6, 0.6, 1.0], "metallicFactor": 1.0, "roughnessFactor": 0.3 }
+        }));
+        let sphere = gltf.mesh("sphere", &[(&uv_sphere(SPHERE_RADIUS, 96, 48), Some(paint))]);
+        let cube_mesh = gltf.mesh("cube", &[(&cube(0.5), Some(steel))]);
+        gltf.node(json!({ "name": "ball", "mesh": sphere, "translation": self.sphere_centre.to_array() }));
+        let rotation = Quat::from_mat3(&(self.cube_linear * Mat3::from_diagonal(Vec3::new(-1.0, 1.0, 1.0) / 1.5)));
+        // The cube sits under a parent node, so that the hierarchy's transforms compose.
+        let child = gltf.node(json!({
+            "name": "box",
+            "mesh": cube_mesh,
+            "rotation": rotation.to_array(),
+            "scale": [-1.5, 1.5, 1.5],
+        }));
+        gltf.node(json!({ "name": "holder", "translation": self.cube_centre.to_array(), "children": [child] }));
+        camera_looking_down_z(&mut gltf, "front", self.eye.to_array(), self.fov, 1.0);
+        gltf.write_gltf(dir, "two-objects")
+    }
+
+    /// The nearest analytic hit: (distance, object id, outward normal).
+    fn trace(&self, origin: Vec3, direction: Vec3) -> Option<(f32, u32, Vec3)> {
+        let mut best: Option<(f32, u32, Vec3)> = None;
+        // The sphere.
+        let oc = origin - self.sphere_centre;
+        let b = oc.dot(direction);
+        let disc = b * b - (oc.length_squared() - SPHERE_RADIUS * SPHERE_RADIUS);
+        if disc > 0.0 {
+            let t = -b - disc.sqrt();
+            let normal = (origin + direction * t - self.sphere_centre).normalize();
+            best = Some((t, 1, normal));
+        }
+        // The cube, as a slab test in its own space.
+        let inverse = self.cube_linear.inverse();
+        let (o, d) = (inverse * (origin - self.cube_centre), inverse * direction);
+        let (mut near, mut far, mut axis) = (f32::MIN, f32::MAX, 0);
+        for k in 0..3 {
+            let (t0, t1) = ((-0.5 - o[k]) / d[k], (0.5 - o[k]) / d[k]);
+            let (lo, hi) = (t0.min(t1), t0.max(t1));
+            if lo > near {
+                near = lo;
+                axis = k;
+            }
+            far = far.min(hi);
+        }
+        if near < far && near > 0.0 && best.is_none_or(|(t, _, _)| near < t) {
+            let mut local = Vec3::ZERO;
+            local[axis] = if d[axis] > 0.0 { -1.0 } else { 1.0 };
+            let normal = (inverse.transpose() * local).normalize();
+            best = Some((near, 2, normal));
+        }
+        best
+    }
+}
+
+fn names(gbuffer: &GBuffer) -> Vec<(u32, String)> {
+    gbuffer.object_names.iter().map(|(id, name)| (*id, name.clone())).collect()
+}
+
+#[test]
+fn a_sphere_and_a_mirrored_cube_bake_to_their_analytic_normals_ids_masks_and_coverage() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = TwoObjects::new();
+    let path = scene.write(dir.path());
+    let size = 160;
+    let g = bake_file(&path, size, 16);
+    assert_eq!(names(&g), [(1, "ball/sphere".to_string()), (2, "box/cube".to_string())]);
+    let keys: Vec<&str> = g.masks.keys().map(String::as_str).collect();
+    assert_eq!(keys, ["red_paint", "steel"]);
+
+    let (mut checked, mut edges, mut coverage_error) = ([0usize; 3], 0, 0.0f64);
+    for y in 0..size {
+        for x in 0..size {
+            let p = (y * size + x) as usize;
+            // The analytic coverage and object at 8×8 points in the pixel.
+            let mut hits = [0u32; 3];
+            for sy in 0..8 {
+                for sx in 0..8 {
+                    let (o, d) = ray(
+                        scene.eye,
+                        scene.fov,
+                        size,
+                        x as f32 + (sx as f32 + 0.5) / 8.0,
+                        y as f32 + (sy as f32 + 0.5) / 8.0,
+                    );
+                    hits[scene.trace(o, d).map_or(0, |h| h.1) as usize] += 1;
+                }
+            }
+            let analytic = (64 - hits[0]) as f32 / 64.0;
+            coverage_error += (g.coverage[p] - analytic).abs() as f64;
+            assert!(
+                (g.coverage[p] - analytic).abs() < 0.2,
+                "pixel ({x}, {y}): coverage {} vs {analytic}",
+                g.coverage[p]
+            );
+            if g.coverage[p] > 0.0 && g.coverage[p] < 1.0 {
+                edges += 1;
+            }
+            // Normals, ids and masks where the whole pixel sees one object.
+            let Some(object) = (1..3).find(|&k| hits[k] == 64) else { continue };
+            let (o, d) = ray(scene.eye, scene.fov, size, x as f32 + 0.5, y as f32 + 0.5);
+            let (_, _, expected) = scene.trace(o, d).unwrap();
+            let baked = Vec3::from(g.normal[p]);
+            // The sphere's 96×48 facets bend smooth normals by well under a degree; the cube's
+            // pixels may straddle an edge, where the average of two faces is right.
+            let limit = if object == 1 { 1.0 } else { 0.5 };
+            let straddles = object == 2 && {
+                let corner = |cx: f32, cy: f32| {
+                    let (o, d) = ray(scene.eye, scene.fov, size, x as f32 + cx, y as f32 + cy);
+                    scene.trace(o, d).map(|h| (h.2 * 100.0).round())
+                };
+                let first = corner(0.0, 0.0);
+                [(1.0, 0.0), (0.0, 1.0), (1.0, 1.0)].iter().any(|&(cx, cy)| corner(cx, cy) != first)
+            };
+            if !straddles {
+                let angle = angle_degrees(baked, expected);
+                assert!(
+                    angle < limit,
+                    "pixel ({x}, {y}) on object {object}: normal {baked} is {angle}° from {expected}"
+                );
+                checked[object] += 1;
+            }
+            assert_eq!(g.object_id[p] as usize, object, "pixel ({x}, {y})");
+            let (own, other) = if object == 1 { ("red_paint", "steel") } else { ("steel", "red_paint") };
+            assert_eq!((g.masks[own][p], g.masks[other][p]), (1.0, 0.0), "pixel ({x}, {y})");
+            let v = Vec3::from(g.view[p]);
+            assert!(angle_degrees(v, -d) < 1.0, "pixel ({x}, {y}): view {v} vs {}", -d);
+            let t = Vec3::from(g.tangent[p]);
+            assert!((t.length() - 1.0).abs() < 1e-3 && t.dot(baked).abs() < 1e-3, "pixel ({x}, {y}): tangent {t}");
+        }
+    }
+    assert!(checked[1] > 2000 && checked[2] > 1000, "too few interior pixels checked: {checked:?}");
+    assert!(edges > 200, "silhouettes are antialiased: only {edges} partly covered pixels");
+    let mean_error = coverage_error / (size * size) as f64;
+    assert!(mean_error < 0.005, "mean coverage error {mean_error}");
+}
+
+#[test]
+fn double_sided_back_faces_face_the_eye_and_single_sided_ones_are_culled() {
+    let dir = tempfile::tempdir().unwrap();
+    for double_sided in [true, false] {
+        let mut gltf = Gltf::new();
+        let material = gltf.material(json!({ "name": "card", "doubleSided": double_sided }));
+        let mesh = gltf.mesh("card", &[(&plane(1.0), Some(material))]);
+        // Turned to face −Z: the camera on +Z sees its back.
+        let turned = Quat::from_rotation_y(std::f32::consts::PI);
+        gltf.node(json!({ "name": "card", "mesh": mesh, "rotation": turned.to_array() }));
+        camera_looking_down_z(&mut gltf, "front", [0.0, 0.0, 4.0], 40.0, 1.0);
+        let g = bake_file(&gltf.write_glb(dir.path(), &format!("card-{double_sided}")), 32, 4);
+        let centre = (16 * 32 + 16) as usize;
+        if double_sided {
+            assert_eq!(g.coverage[centre], 1.0);
+            let n = Vec3::from(g.normal[centre]);
+            assert!(angle_degrees(n, Vec3::Z) < 0.01, "the back face's normal faces the eye: {n}");
+        } else {
+            assert_eq!(g.coverage.iter().sum::<f32>(), 0.0, "a single-sided back face is not drawn");
+        }
+    }
+}
+
+/// A 2×2 normal map, one tilt per quadrant, encoded as glTF stores tangent-space normals.
+fn quadrant_normal_map() -> (image::RgbaImage, [[f32; 3]; 4]) {
+    let tilts = [[0.4, 0.3], [-0.5, 0.2], [0.2, -0.6], [-0.3, -0.3]];
+    let mut image = image::RgbaImage::new(2, 2);
+    let mut normals = [[0.0; 3]; 4];
+    for (k, [x, y]) in tilts.into_iter().enumerate() {
+        let n = Vec3::new(x, y, (1.0f32 - x * x - y * y).sqrt());
+        let encode = |c: f32| ((c * 0.5 + 0.5) * 255.0).round() as u8;
+        image.put_pixel(k as u32 % 2, k as u32 / 2, image::Rgba([encode(n.x), encode(n.y), encode(n.z), 255]));
+        // What the stored bytes decode to.
+        let decoded = Vec3::new(encode(n.x) as f32, encode(n.y) as f32, encode(n.z) as f32) / 255.0 * 2.0 - 1.0;
+        normals[k] = decoded.to_array();
+    }
+    (image, normals)
+}
+
+#[test]
+fn a_normal_mapped_plane_bakes_to_the_perturbed_normals_with_given_or_generated_tangents() {
+    let dir = tempfile::tempdir().unwrap();
+    let (image, normals) = quadrant_normal_map();
+    for given_tangents in [false, true] {
+        let mut gltf = Gltf::new();
+        let texture = gltf.texture(&image);
+        gltf.json["samplers"] = json!([{ "magFilter": 9728, "minFilter": 9728 }]);
+        gltf.json["textures"][texture]["sampler"] = json!(0);
+        let material = gltf.material(json!({ "name": "bumpy", "normalTexture": { "index": texture, "scale": 0.5 } }));
+        let mut mesh: Mesh = plane(1.0);
+        if given_tangents {
+            mesh.tangents = Some(vec![[1.0, 0.0, 0.0, 1.0]; 4]);
+        }
+        let mesh = gltf.mesh("plane", &[(&mesh, Some(material))]);
+        gltf.node(json!({ "name": "plane", "mesh": mesh }));
+        // The plane fills the frame: half-size 1 at distance 1/tan(20°).
+        let distance = 1.0 / 20f32.to_radians().tan();
+        camera_looking_down_z(&mut gltf, "front", [0.0, 0.0, distance], 40.0, 1.0);
+        let g = bake_file(&gltf.write_gltf(dir.path(), &format!("bumpy-{given_tangents}")), 64, 1);
+        for (k, stored) in normals.iter().enumerate() {
+            // The quadrant's centre: top-left of the image is u, v = 0, at world (−1, +1).
+            let (x, y) = (16 + 32 * (k % 2), 16 + 32 * (k / 2));
+            let m = Vec3::from(*stored);
+            // The normal scale multiplies the tangent-space x and y; T = +X and B = +Y.
+            let expected = Vec3::new(m.x * 0.5, m.y * 0.5, m.z).normalize();
+            let baked = Vec3::from(g.normal[y * 64 + x]);
+            let angle = angle_degrees(baked, expected);
+            assert!(angle < 0.2, "tangents given: {given_tangents}, quadrant {k}: {baked} is {angle}° from {expected}");
+            let tangent = Vec3::from(g.tangent[y * 64 + x]);
+            assert!(tangent.dot(Vec3::X) > 0.9, "the tangent follows +u: {tangent}");
+        }
+    }
+}
+
+#[test]
+fn vertex_colours_and_metallic_roughness_textures_become_masks() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut gltf = Gltf::new();
+    // Left half metallic 1 and roughness 0.2; right half metallic 0 and roughness 1 (B and G).
+    let texture = gltf.texture(&image::RgbaImage::from_fn(2, 1, |x, _| {
+        if x == 0 {
+            image::Rgba([0, 51, 255, 255])
+        } else {
+            image::Rgba([0, 255, 0, 255])
+        }
+    }));
+    gltf.json["samplers"] = json!([{ "magFilter": 9728, "minFilter": 9728 }]);
+    gltf.json["textures"][texture]["sampler"] = json!(0);
+    let material = gltf.material(json!({
+        "name": "worn",
+        "pbrMetallicRoughness": { "metallicRoughnessTexture": { "index": texture }, "roughnessFactor": 0.9 }
+    }));
+    let mut mesh = plane(1.0);
+    mesh.colors = Some(vec![[1.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0, 0.5], [0.0, 0.0, 1.0, 0.5]]);
+    let mesh = gltf.mesh("plane", &[(&mesh, Some(material))]);
+    gltf.node(json!({ "name": "plane", "mesh": mesh }));
+    camera_looking_down_z(&mut gltf, "front", [0.0, 0.0, 1.0 / 20f32.to_radians().tan()], 40.0, 1.0);
+    let g = bake_file(&gltf.write_gltf(dir.path(), "worn"), 64, 4);
+    let at = |name: &str, x: usize, y: usize| g.masks[name][y * 64 + x];
+    // Vertex colours: red along the top edge, blue (alpha 0.5) along the bottom.
+    assert!((at("color0.r", 32, 1) - 1.0).abs() < 0.05 && at("color0.b", 32, 1) < 0.05);
+    assert!((at("color0.b", 32, 62) - 1.0).abs() < 0.05 && (at("color0.a", 32, 62) - 0.5).abs() < 0.05);
+    assert!((at("color0.r", 32, 32) - 0.5).abs() < 0.05, "colours interpolate");
+    // The texture's raw channels.
+    for (x, m, r) in [(16, 1.0, 0.2), (48, 0.0, 1.0)] {
+        assert!((at("worn.metallic", x, 32) - m).abs() < 0.01, "metallic at x = {x}");
+        assert!((at("worn.roughness", x, 32) - r).abs() < 0.01, "roughness at x = {x}");
+        assert!((at("worn.rough_metal", x, 32) - m * r).abs() < 0.01);
+        let dielectric = if m * r < 1.0 { (1.0 - m) * r / (1.0 - m * r) } else { 0.0 };
+        assert!((at("worn.rough_dielectric", x, 32) - dielectric).abs() < 0.01);
+    }
+}
+
+fn lookdev(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lookdev")).args(args).env("LOOKDEV_VALIDATION", "1").output().unwrap()
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+fn assert_success(output: &Output) {
+    assert!(output.status.success(), "failed: {}", stderr(output));
+}
+
+#[test]
+fn the_mapping_holds_for_every_listed_extension_and_unsupported_ones_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut gltf = Gltf::new();
+    for name in [
+        "KHR_materials_ior",
+        "KHR_materials_specular",
+        "KHR_materials_clearcoat",
+        "KHR_materials_sheen",
+        "KHR_materials_anisotropy",
+        "KHR_materials_transmission",
+    ] {
+        gltf.uses_extension(name);
+    }
+    let material = gltf.material(json!({
+        "name": "Lacquer.01",
+        "pbrMetallicRoughness": { "baseColorFactor": [0.5, 0.25, 0.1, 1.0], "metallicFactor": 0.2, "roughnessFactor": 0.6 },
+        "extensions": {
+            "KHR_materials_ior": { "ior": 1.8 },
+            "KHR_materials_specular": { "specularFactor": 0.5, "specularColorFactor": [1.0, 1.0, 1.0] },
+            "KHR_materials_clearcoat": { "clearcoatFactor": 0.5, "clearcoatRoughnessFactor": 0.2 },
+            "KHR_materials_sheen": { "sheenColorFactor": [0.3, 0.3, 0.3] },
+            "KHR_materials_anisotropy": { "anisotropyStrength": 0.6 },
+            "KHR_materials_transmission": { "transmissionFactor": 0.5 }
+        }
+    }));
+    let mesh = gltf.mesh("ball", &[(&uv_sphere(1.0, 16, 8), Some(material))]);
+    gltf.node(json!({ "name": "ball", "mesh": mesh }));
+    let path = gltf.write_gltf(dir.path(), "lacquer");
+
+    let asset = Asset::load(&path).unwrap();
+    let import = Import::new(&asset).unwrap();
+    assert_eq!(import.unsupported, ["KHR_materials_transmission"]);
+    let [imported] = &import.materials[..] else { panic!("one material") };
+    assert_eq!((imported.used.channel.as_str(), imported.preset.name.as_str()), ("Lacquer_01", "lacquer_01"));
+    let p = imported.preset.params;
+    let close = |a: f32, b: f32, what: &str| assert!((a - b).abs() < 1e-4, "{what}: {a} vs {b}");
+    close(p.base_color[0], 0.5, "base_color.r");
+    close(p.base_color[2], 0.1, "base_color.b");
+    close(p.metallic, 0.2, "metallic");
+    close(p.roughness, 0.6, "roughness");
+    // F0 of IOR 1.8 is (0.8/2.8)², scaled by the specular factor, over Disney's 0.08.
+    close(p.specular, (0.8f32 / 2.8).powi(2) * 0.5 / 0.08, "specular");
+    close(p.specular_tint, 0.0, "specular_tint");
+    // A full glTF coat is Disney clearcoat 4 (its lobe has a 0.25 weight).
+    close(p.clearcoat, 2.0, "clearcoat");
+    // GTR1's alpha mix(0.1, 0.001, gloss) equals the coat's alpha 0.2².
+    close(0.1 + (0.001 - 0.1) * p.clearcoat_gloss, 0.04, "clearcoat alpha");
+    close(p.sheen, 0.3, "sheen");
+    close(p.sheen_tint, 0.0, "sheen_tint");
+    // Disney's alpha ratio 1/(1 − 0.9·anisotropic) equals glTF's stretch mix(α, 1, s²)/α.
+    let alpha = 0.6f32 * 0.6;
+    close(1.0 / (1.0 - 0.9 * p.anisotropic), (alpha + 0.36 * (1.0 - alpha)) / alpha, "anisotropy ratio");
+    assert!(
+        imported.mapped.notes.iter().any(|n| n.contains("KHR_materials_transmission")),
+        "{:?}",
+        imported.mapped.notes
+    );
+
+    // The CLI writes the preset and the look, and warns of the extension it ignores.
+    let (presets, look) = (dir.path().join("presets"), dir.path().join("lacquer.toml"));
+    let output = lookdev(&[
+        "import",
+        path.to_str().unwrap(),
+        "--presets",
+        presets.to_str().unwrap(),
+        "--look",
+        look.to_str().unwrap(),
+    ]);
+    assert_success(&output);
+    assert!(
+        stderr(&output).contains("warning") && stderr(&output).contains("KHR_materials_transmission"),
+        "{}",
+        stderr(&output)
+    );
+    let written = lookdev::material::Preset::load(&presets.join("lacquer_01.toml")).unwrap();
+    assert_eq!(written.params, p, "the preset file holds the mapped values");
+    let look_text = std::fs::read_to_string(&look).unwrap();
+    assert!(look_text.contains("preset = \"presets/lacquer_01.toml\""), "{look_text}");
+    // Importing again without --force refuses, and leaves the files as they were.
+    let again = lookdev(&[
+        "import",
+        path.to_str().unwrap(),
+        "--presets",
+        presets.to_str().unwrap(),
+        "--look",
+        look.to_str().unwrap(),
+    ]);
+    assert_eq!(again.status.code(), Some(2), "{}", stderr(&again));
+    assert!(stderr(&again).contains("already exists"), "{}", stderr(&again));
+    assert_eq!(std::fs::read_to_string(&look).unwrap(), look_text);
+}
+
+fn read_exr(path: &Path) -> Vec<[f32; 4]> {
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |resolution, _| (resolution.width(), vec![[0.0; 4]; resolution.area()]),
+        |(w, pixels), position, (r, g, b, a): (f32, f32, f32, f32)| {
+            pixels[position.y() * *w + position.x()] = [r, g, b, a]
+        },
+    )
+    .unwrap();
+    image.layer_data.channel_data.pixels.1
+}
+
+#[test]
+fn baking_and_rendering_a_gltf_sphere_matches_the_built_in_analytic_sphere() {
+    let dir = tempfile::tempdir().unwrap();
+    let arg = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    // The built-in ball: a unit sphere at the origin, seen from (0, 0, 5.5) with a 30° field of view.
+    let mut gltf = Gltf::new();
+    let material = gltf.material(json!({
+        "name": "terracotta",
+        "pbrMetallicRoughness": { "baseColorFactor": [0.8, 0.3, 0.1, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.4 },
+        "extensions": { "KHR_materials_clearcoat": { "clearcoatFactor": 0.25, "clearcoatRoughnessFactor": 0.1 } }
+    }));
+    gltf.uses_extension("KHR_materials_clearcoat");
+    let mesh = gltf.mesh("sphere", &[(&uv_sphere(1.0, 128, 64), Some(material))]);
+    gltf.node(json!({ "name": "ball", "mesh": mesh }));
+    camera_looking_down_z(&mut gltf, "front", [0.0, 0.0, 5.5], 30.0, 1.0);
+    let model = gltf.write_glb(dir.path(), "ball");
+    let model = model.to_str().unwrap();
+
+    let size = "96";
+    assert_success(&lookdev(&[
+        "bake",
+        model,
+        "--out",
+        &arg("baked.exr"),
+        "--size",
+        size,
+        size,
+        "--samples",
+        "16",
+        "--quiet",
+    ]));
+    assert_success(&lookdev(&["import", model, "--presets", &arg("presets"), "--look", &arg("ball.toml")]));
+    assert_success(&lookdev(&[
+        "gbuffer",
+        "--builtin",
+        "shaderball",
+        "--size",
+        size,
+        size,
+        "--out",
+        &arg("analytic.exr"),
+    ]));
+    std::fs::write(
+        dir.path().join("analytic.toml"),
+        "[[object]]\n[[object.layer]]\npreset = \"presets/terracotta.toml\"\n",
+    )
+    .unwrap();
+    let render = |gbuffer: &str, look: &str, out: &str| {
+        assert_success(&lookdev(&[
+            "render",
+            "--gbuffer",
+            &arg(gbuffer),
+            "--look",
+            &arg(look),
+            "--spp",
+            "64",
+            "--seed",
+            "3",
+            "--no-background",
+            "--out",
+            &arg(out),
+            "--quiet",
+        ]));
+        read_exr(&dir.path().join(out))
+    };
+    let baked = render("baked.exr", "ball.toml", "baked-render.exr");
+    let analytic = render("analytic.exr", "analytic.toml", "analytic-render.exr");
+
+    let analytic_gbuffer = GBuffer::read(&dir.path().join("analytic.exr")).unwrap();
+    let baked_gbuffer = GBuffer::read(&dir.path().join("baked.exr")).unwrap();
+    let (mut sum_baked, mut sum_analytic, mut sum_difference, mut count) = (0.0f64, 0.0f64, 0.0f64, 0);
+    for p in 0..baked.len() {
+        let on_ball = analytic_gbuffer.object_id[p] == lookdev::gbuffer::BALL_ID && analytic_gbuffer.coverage[p] == 1.0;
+        if !on_ball || baked_gbuffer.coverage[p] < 1.0 {
+            continue;
+        }
+        let luminance = |c: [f32; 4]| (0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]) as f64;
+        sum_baked += luminance(baked[p]);
+        sum_analytic += luminance(analytic[p]);
+        sum_difference += (luminance(baked[p]) - luminance(analytic[p])).abs();
+        count += 1;
+    }
+    assert!(count > 2000, "{count} ball pixels");
+    let mean_difference = sum_difference / sum_analytic;
+    let bias = (sum_baked - sum_analytic) / sum_analytic;
+    assert!(bias.abs() < 0.01, "the baked ball is {:.2}% brighter", bias * 100.0);
+    assert!(mean_difference < 0.03, "per-pixel difference {:.2}%", mean_difference * 100.0);
+}
+
+/// Exit code 2 and one error line naming the file and the problem.
+fn assert_bad_input(output: &Output, fragments: &[&str]) {
+    let text = stderr(output);
+    assert_eq!(output.status.code(), Some(2), "expected exit code 2, got {:?}: {text}", output.status.code());
+    assert!(!text.contains("panicked"), "{text}");
+    let errors: Vec<&str> = text.lines().filter(|l| l.starts_with("lookdev: error:")).collect();
+    assert_eq!(errors.len(), 1, "expected one error line: {text}");
+    for fragment in fragments {
+        assert!(errors[0].contains(fragment), "error line lacks '{fragment}': {}", errors[0]);
+    }
+}
+
+/// A one-sphere asset, changed by `edit` before it is written as `<name>.gltf`.
+fn broken_asset(dir: &Path, name: &str, edit: impl FnOnce(&mut Gltf)) -> String {
+    let mut gltf = Gltf::new();
+    let mesh = gltf.mesh("sphere", &[(&uv_sphere(1.0, 8, 4), None)]);
+    gltf.node(json!({ "name": "ball", "mesh": mesh }));
+    edit(&mut gltf);
+    gltf.write_gltf(dir, name).to_string_lossy().into_owned()
+}
+
+#[test]
+fn bad_assets_are_refused_with_the_file_and_the_problem_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("g.exr").to_string_lossy().into_owned();
+    let bake = |model: &str, extra: &[&str]| {
+        let mut args = vec!["bake", model, "--out", &out, "--size", "16", "16", "--samples", "1"];
+        args.extend_from_slice(extra);
+        lookdev(&args)
+    };
+    let missing_buffer = broken_asset(dir.path(), "no-bin", |_| {});
+    std::fs::remove_file(dir.path().join("no-bin.bin")).unwrap();
+    assert_bad_input(&bake(&missing_buffer, &[]), &["no-bin.gltf", "buffer 0", "no-bin.bin"]);
+
+    let missing_image = broken_asset(dir.path(), "no-image", |g| {
+        g.json["images"] = json!([{ "uri": "albedo.png" }]);
+        g.json["textures"] = json!([{ "source": 0 }]);
+        g.json["materials"] = json!([{ "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 } } }]);
+        g.json["meshes"][0]["primitives"][0]["material"] = json!(0);
+    });
+    assert_bad_input(&bake(&missing_image, &[]), &["no-image.gltf", "image 0", "albedo.png"]);
+
+    let lines = broken_asset(dir.path(), "lines", |g| g.json["meshes"][0]["primitives"][0]["mode"] = json!(1));
+    assert_bad_input(&bake(&lines, &[]), &["lines.gltf", "LINES", "only triangles"]);
+
+    let empty = broken_asset(dir.path(), "empty", |g| {
+        g.json["nodes"] = json!([{ "name": "nothing" }]);
+    });
+    assert_bad_input(&bake(&empty, &[]), &["empty.gltf", "no meshes"]);
+
+    let wide = broken_asset(dir.path(), "wide", |g| {
+        camera_looking_down_z(g, "fisheye", [0.0, 0.0, 5.0], 200.0, 1.0);
+    });
+    assert_bad_input(&bake(&wide, &[]), &["wide.gltf", "fisheye", "yfov"]);
+    assert_bad_input(&bake(&wide, &["--camera", "nope"]), &["wide.gltf", "no camera named 'nope'", "fisheye"]);
+    assert_bad_input(&bake(&wide, &["--auto-camera", "--fov", "180"]), &["--fov 180"]);
+
+    for (extension, what) in [("KHR_draco_mesh_compression", "Draco"), ("EXT_meshopt_compression", "meshopt")] {
+        let compressed = broken_asset(dir.path(), "compressed", |g| {
+            g.json["extensionsUsed"] = json!([extension]);
+            g.json["extensionsRequired"] = json!([extension]);
+        });
+        assert_bad_input(&bake(&compressed, &[]), &["compressed.gltf", what, "not supported"]);
+        let import = lookdev(&["import", &compressed, "--presets", &out, "--look", &out]);
+        assert_bad_input(&import, &["compressed.gltf", what]);
+    }
+
+    std::fs::write(dir.path().join("text.gltf"), "{ not json").unwrap();
+    let text = dir.path().join("text.gltf").to_string_lossy().into_owned();
+    assert_bad_input(&bake(&text, &[]), &["text.gltf", "not a readable glTF file"]);
+    let absent = dir.path().join("absent.glb").to_string_lossy().into_owned();
+    assert_bad_input(&bake(&absent, &[]), &["absent.glb", "cannot read"]);
+    assert!(!Path::new(&out).exists(), "no g-buffer is written for bad input");
+}
