@@ -598,3 +598,29 @@ fn bad_assets_are_refused_with_the_file_and_the_problem_named() {
     assert_bad_input(&bake(&absent, &[]), &["absent.glb", "cannot read"]);
     assert!(!Path::new(&out).exists(), "no g-buffer is written for bad input");
 }
+
+#[test]
+fn alpha_masked_materials_cut_out_what_is_below_the_cutoff() {
+    let dir = tempfile::tempdir().unwrap();
+    // (factor alpha, texture alpha left and right): what is drawn on the left and the right.
+    for (factor, expect_left, expect_right) in [(1.0, false, true), (0.4, false, false)] {
+        let mut gltf = Gltf::new();
+        let texture = gltf.texture(&image::RgbaImage::from_fn(2, 1, |x, _| {
+            image::Rgba([200, 200, 200, if x == 0 { 0 } else { 255 }])
+        }));
+        gltf.json["samplers"] = json!([{ "magFilter": 9728, "minFilter": 9728 }]);
+        gltf.json["textures"][texture]["sampler"] = json!(0);
+        let material = gltf.material(json!({
+            "name": "leaf",
+            "alphaMode": "MASK",
+            "alphaCutoff": 0.5,
+            "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, factor], "baseColorTexture": { "index": texture } }
+        }));
+        let mesh = gltf.mesh("plane", &[(&plane(1.0), Some(material))]);
+        gltf.node(json!({ "name": "plane", "mesh": mesh }));
+        camera_looking_down_z(&mut gltf, "front", [0.0, 0.0, 1.0 / 20f32.to_radians().tan()], 40.0, 1.0);
+        let g = bake_file(&gltf.write_gltf(dir.path(), &format!("leaf-{factor}")), 32, 1);
+        let drawn = |x: usize| g.coverage[16 * 32 + x] == 1.0;
+        assert_eq!((drawn(8), drawn(24)), (expect_left, expect_right), "factor alpha {factor}");
+    }
+}

@@ -297,7 +297,12 @@ impl Rasterizer {
                 flags,
                 normal.as_ref().map_or(1.0, |t| t.scale()),
                 uv_sets,
-                material.alpha_cutoff().unwrap_or(0.5),
+                // The shader compares COLOR_0's alpha times the texture's; dividing the cutoff
+                // by the factor's alpha brings that in too.
+                match pbr.base_color_factor()[3] {
+                    factor if factor > 0.0 => material.alpha_cutoff().unwrap_or(0.5) / factor,
+                    _ => f32::MAX,
+                },
                 (anisotropy.cos(), anisotropy.sin()),
             ));
             bindings.push([
