@@ -2,7 +2,7 @@
 // The bake's fragment stage: one g-buffer sample of the nearest surface (README: lookdev bake).
 // Writes the shading normal (the normal map applied through the MikkTSpace tangent frame), the
 // tangent (turned by the material's anisotropy rotation), the view vector, the object and
-// material, COLOR_0, and the raw metallic and roughness texture values. Back faces of
+// material, COLOR_0, the raw metallic and roughness texture values and the base colour texture. Back faces of
 // double-sided materials turn their whole frame around, as glTF asks.
 #extension GL_GOOGLE_include_directive : require
 
@@ -25,20 +25,23 @@ layout(location = 2) out vec4 out_view;         // xyz
 layout(location = 3) out uvec2 out_ids;         // object id, material index + 1
 layout(location = 4) out vec4 out_color;        // COLOR_0
 layout(location = 5) out vec2 out_metal_rough;  // the texture's B (metallic) and G (roughness)
+layout(location = 6) out vec4 out_base_color;   // the base colour texture, linear; white without one
 
 vec2 texcoord(uint set) {
     return set == 1u ? uv1 : uv0;
 }
 
+vec3 srgb_to_linear(vec3 c) {
+    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
+}
+
 void main() {
-    if ((draw.flags & DRAW_ALPHA_MASK) != 0u) {
-        float alpha = color.a;
-        if ((draw.flags & DRAW_BASE_COLOR_MAP) != 0u) {
-            alpha *= texture(base_color_map, texcoord(uv_set(4u))).a;
-        }
-        if (alpha < draw.alpha_cutoff) {
-            discard;
-        }
+    vec4 base_color = vec4(1.0);
+    if ((draw.flags & DRAW_BASE_COLOR_MAP) != 0u) {
+        base_color = texture(base_color_map, texcoord(uv_set(4u)));
+    }
+    if ((draw.flags & DRAW_ALPHA_MASK) != 0u && color.a * base_color.a < draw.alpha_cutoff) {
+        discard;
     }
     vec3 n = normalize(world_normal);
     vec3 t = world_tangent.xyz - n * dot(n, world_tangent.xyz);
@@ -72,4 +75,6 @@ void main() {
     out_ids = uvec2(draw.object_id, draw.material);
     out_color = color;
     out_metal_rough = metal_rough;
+    // Filtered as stored (sRGB), then decoded: the texture is a plain UNORM image.
+    out_base_color = vec4(srgb_to_linear(base_color.rgb), base_color.a);
 }

@@ -279,42 +279,85 @@ fn a_normal_mapped_plane_bakes_to_the_perturbed_normals_with_given_or_generated_
     }
 }
 
+fn srgb_to_linear(c: u8) -> f32 {
+    let c = c as f32 / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 #[test]
-fn vertex_colours_and_metallic_roughness_textures_become_masks() {
+fn vertex_colours_and_textures_become_masks_and_layers_that_reproduce_every_texel() {
     let dir = tempfile::tempdir().unwrap();
     let mut gltf = Gltf::new();
-    // Left half metallic 1 and roughness 0.2; right half metallic 0 and roughness 1 (B and G).
-    let texture = gltf.texture(&image::RgbaImage::from_fn(2, 1, |x, _| {
+    // Left half metallic 1 and roughness 0.2, right half metallic 0 and roughness 1 (B and G);
+    // a base colour texture of a rust colour on the left and a pale one on the right.
+    let metal_rough = gltf.texture(&image::RgbaImage::from_fn(2, 1, |x, _| {
         if x == 0 {
             image::Rgba([0, 51, 255, 255])
         } else {
             image::Rgba([0, 255, 0, 255])
         }
     }));
+    let colors = [[150u8, 60, 20], [230, 200, 170]];
+    let albedo = gltf.texture(&image::RgbaImage::from_fn(2, 1, |x, _| {
+        let [r, g, b] = colors[x as usize];
+        image::Rgba([r, g, b, 255])
+    }));
     gltf.json["samplers"] = json!([{ "magFilter": 9728, "minFilter": 9728 }]);
-    gltf.json["textures"][texture]["sampler"] = json!(0);
+    for texture in [metal_rough, albedo] {
+        gltf.json["textures"][texture]["sampler"] = json!(0);
+    }
+    let factor = [0.9, 0.8, 1.0];
     let material = gltf.material(json!({
         "name": "worn",
-        "pbrMetallicRoughness": { "metallicRoughnessTexture": { "index": texture }, "roughnessFactor": 0.9 }
+        "pbrMetallicRoughness": {
+            "metallicRoughnessTexture": { "index": metal_rough },
+            "roughnessFactor": 0.9,
+            "baseColorTexture": { "index": albedo },
+            "baseColorFactor": [factor[0], factor[1], factor[2], 1.0]
+        }
     }));
     let mut mesh = plane(1.0);
     mesh.colors = Some(vec![[1.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0, 0.5], [0.0, 0.0, 1.0, 0.5]]);
     let mesh = gltf.mesh("plane", &[(&mesh, Some(material))]);
     gltf.node(json!({ "name": "plane", "mesh": mesh }));
     camera_looking_down_z(&mut gltf, "front", [0.0, 0.0, 1.0 / 20f32.to_radians().tan()], 40.0, 1.0);
-    let g = bake_file(&gltf.write_gltf(dir.path(), "worn"), 64, 4);
+    let path = gltf.write_gltf(dir.path(), "worn");
+    let g = bake_file(&path, 64, 4);
     let at = |name: &str, x: usize, y: usize| g.masks[name][y * 64 + x];
     // Vertex colours: red along the top edge, blue (alpha 0.5) along the bottom.
     assert!((at("color0.r", 32, 1) - 1.0).abs() < 0.05 && at("color0.b", 32, 1) < 0.05);
     assert!((at("color0.b", 32, 62) - 1.0).abs() < 0.05 && (at("color0.a", 32, 62) - 0.5).abs() < 0.05);
     assert!((at("color0.r", 32, 32) - 0.5).abs() < 0.05, "colours interpolate");
-    // The texture's raw channels.
-    for (x, m, r) in [(16, 1.0, 0.2), (48, 0.0, 1.0)] {
+
+    // The texture's raw values, and the look's layers through the corner masks.
+    let asset = Asset::load(&path).unwrap();
+    let import = Import::new(&asset).unwrap();
+    let look = import.look(&dir.path().join("worn.toml"), str::to_string);
+    assert_eq!(look.objects[0].layers.len(), 8, "the material and the seven other corners of its three axes");
+    let stack = &look.objects[0];
+    for (x, texel) in [(16usize, 0usize), (48, 1)] {
+        let (m, r) = if texel == 0 { (1.0, 0.2) } else { (0.0, 1.0) };
         assert!((at("worn.metallic", x, 32) - m).abs() < 0.01, "metallic at x = {x}");
         assert!((at("worn.roughness", x, 32) - r).abs() < 0.01, "roughness at x = {x}");
-        assert!((at("worn.rough_metal", x, 32) - m * r).abs() < 0.01);
-        let dielectric = if m * r < 1.0 { (1.0 - m) * r / (1.0 - m * r) } else { 0.0 };
-        assert!((at("worn.rough_dielectric", x, 32) - dielectric).abs() < 0.01);
+        let weights = lookdev::material::stack::layer_weights(stack, |name| at(name, x, 32));
+        let mut blended = stack.layers[0].params;
+        for (layer, weight) in stack.layers.iter().zip(weights).skip(1) {
+            blended = blended.mix(&layer.params, weight.unwrap().blend);
+        }
+        assert!((blended.metallic - m).abs() < 0.01, "metallic at x = {x}: {}", blended.metallic);
+        assert!((blended.roughness - 0.9 * r).abs() < 0.01, "roughness at x = {x}: {}", blended.roughness);
+        let expected = [0, 1, 2].map(|k| factor[k] * srgb_to_linear(colors[texel][k]));
+        for k in 0..3 {
+            assert!(
+                (blended.base_color[k] - expected[k]).abs() < 0.01,
+                "base colour at x = {x}: {:?} vs {expected:?}",
+                blended.base_color
+            );
+        }
     }
 }
 

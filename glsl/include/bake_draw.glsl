@@ -1,4 +1,4 @@
-// The per-draw constants of the bake's vertex and fragment shaders (src/asset/raster.rs: Draw),
+// The per-draw constants of the bake's vertex and fragment shaders (src/asset/bake.rs: DrawConstants),
 // 128 bytes: the least every device allows.
 layout(push_constant) uniform Draw {
     mat4 view_projection;   // world to clip, with the pass's sub-pixel jitter

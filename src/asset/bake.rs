@@ -9,7 +9,7 @@
 
 use super::camera::{self, Camera, CameraChoice};
 use super::geometry::{self, Geometry, Vertex};
-use super::materials::{self, UsedMaterial};
+use super::materials::{self, material_of, Axis, UsedMaterial};
 use super::Asset;
 use crate::gbuffer::stable_tangent;
 use crate::gbuffer::GBuffer;
@@ -57,13 +57,14 @@ const DRAW_ALPHA_MASK: u32 = 8;
 const DRAW_BASE_COLOR_MAP: u32 = 16;
 
 /// The render targets, in the fragment shader's output order, with their formats.
-const TARGETS: [vk::Format; 6] = [
+const TARGETS: [vk::Format; 7] = [
     vk::Format::R32G32B32A32_SFLOAT, // normal, w = covered
     vk::Format::R32G32B32A32_SFLOAT, // tangent, w = bitangent sign
     vk::Format::R32G32B32A32_SFLOAT, // view
     vk::Format::R32G32_UINT,         // object id, material + 1
     vk::Format::R32G32B32A32_SFLOAT, // COLOR_0
     vk::Format::R32G32_SFLOAT,       // metallic, roughness texture values
+    vk::Format::R32G32B32A32_SFLOAT, // base colour texture, linear
 ];
 
 /// A material as the fragment shader sees it: its constants and its textures.
@@ -114,6 +115,14 @@ pub fn bake(
     let camera = camera::choose(asset, &options.camera, geometry.bounds, width, height)?;
     let used = materials::used(asset, geometry.draws.iter().map(|d| d.material));
 
+    if ctx.info().max_color_attachments < TARGETS.len() as u32 {
+        return Err(Error::gpu(format!(
+            "{} draws to {} colour targets at once, and the bake writes {}",
+            ctx.info().name,
+            ctx.info().max_color_attachments,
+            TARGETS.len()
+        )));
+    }
     let rasterizer = Rasterizer::new(ctx, asset, &geometry, &used, width, height)?;
     let mut accumulator = Accumulator::new(width, height, &used, asset, &geometry);
     for (pass, offset) in jitter_pattern(options.samples).into_iter().enumerate() {
@@ -180,6 +189,7 @@ struct Samples<'a> {
     ids: &'a [[u32; 2]],
     color: &'a [[f32; 4]],
     metal_rough: &'a [[f32; 2]],
+    base_color: &'a [[f32; 4]],
 }
 
 impl Rasterizer {
@@ -264,15 +274,12 @@ impl Rasterizer {
         let mut bindings = Vec::new();
         let mut constants = Vec::new();
         for used_material in used {
-            let material = match used_material.index {
-                Some(i) => asset.document.materials().nth(i).expect("used materials exist"),
-                None => default_material(&asset.document),
-            };
+            let material = material_of(asset, used_material.index);
             let pbr = material.pbr_metallic_roughness();
             let normal = material.normal_texture();
             let metal_rough = pbr.metallic_roughness_texture();
             let masked = material.alpha_mode() == gltf::material::AlphaMode::Mask;
-            let base_color = pbr.base_color_texture().filter(|_| masked);
+            let base_color = pbr.base_color_texture();
             let mut flags = 0;
             if material.double_sided() {
                 flags |= DRAW_DOUBLE_SIDED;
@@ -421,18 +428,9 @@ impl Rasterizer {
             ids: bytemuck::cast_slice(next(8)),
             color: bytemuck::cast_slice(next(16)),
             metal_rough: bytemuck::cast_slice(next(8)),
+            base_color: bytemuck::cast_slice(next(16)),
         })
     }
-}
-
-/// glTF's default material, for primitives without one.
-fn default_material(document: &gltf::Document) -> gltf::Material<'_> {
-    document
-        .meshes()
-        .flat_map(|m| m.primitives())
-        .map(|p| p.material())
-        .find(|m| m.index().is_none())
-        .expect("a draw uses it")
 }
 
 /// A hashable form of [`SamplerDesc`].
@@ -484,19 +482,83 @@ struct Accumulator {
     material_hits: Vec<Vec<u16>>,
     /// COLOR_0 sums, when any primitive has vertex colours.
     color: Option<Vec<Vec4>>,
-    /// Per used material with a metallic-roughness texture: sums of metallic, roughness,
-    /// (1 − m)·r/(1 − m·r) and m·r over the samples on it.
-    metal_rough: Vec<Option<Vec<[f32; 4]>>>,
+    /// Per used material with a metallic-roughness texture or texture axes: its texture sums.
+    textures: Vec<Option<TextureSums>>,
+}
+
+/// Per-pixel sums, over a material's samples, of its texture values and corner-layer weights
+/// (README: Texture layers).
+struct TextureSums {
+    /// Whether the material has a metallic-roughness texture, whose raw values are always masks.
+    metal_rough: bool,
+    axes: Vec<Axis>,
+    /// The base colour factor, which multiplies the texture's texels.
+    color_factor: [f32; 3],
+    /// Per pixel: metallic, roughness, then one position per axis, then the weight of each
+    /// corner layer but the first.
+    sums: Vec<f32>,
+    stride: usize,
+}
+
+impl TextureSums {
+    fn new(material: &gltf::Material, axes: Vec<Axis>, pixels: usize) -> TextureSums {
+        let stride = 2 + axes.len() + (1 << axes.len()) - 1;
+        let factor = material.pbr_metallic_roughness().base_color_factor();
+        TextureSums {
+            metal_rough: material.pbr_metallic_roughness().metallic_roughness_texture().is_some(),
+            axes,
+            color_factor: [factor[0], factor[1], factor[2]],
+            sums: vec![0.0; pixels * stride],
+            stride,
+        }
+    }
+
+    fn add(&mut self, pixel: usize, metal_rough: [f32; 2], color: [f32; 4]) {
+        let color = [0, 1, 2].map(|k| color[k] * self.color_factor[k]);
+        let positions: Vec<f32> = self.axes.iter().map(|axis| axis.position(metal_rough, color)).collect();
+        let sums = &mut self.sums[pixel * self.stride..(pixel + 1) * self.stride];
+        let values = metal_rough.iter().chain(&positions).copied().chain(materials::corner_weights(&positions));
+        for (sum, value) in sums.iter_mut().zip(values) {
+            *sum += value;
+        }
+    }
+
+    /// The masks, each sum over the pixel's hits on any material: so that where materials meet,
+    /// each one's texture layers take only its share.
+    fn masks(&self, channel: &str, hits: &[u16], masks: &mut BTreeMap<String, Vec<f32>>) {
+        let mean = |k: usize| -> Vec<f32> {
+            hits.iter()
+                .enumerate()
+                .map(|(p, &h)| if h > 0 { self.sums[p * self.stride + k] / h as f32 } else { 0.0 })
+                .collect()
+        };
+        if self.metal_rough {
+            masks.insert(format!("{channel}.metallic"), mean(0));
+            masks.insert(format!("{channel}.roughness"), mean(1));
+        }
+        for (i, axis) in self.axes.iter().enumerate() {
+            if matches!(axis, Axis::BaseColor { .. }) {
+                masks.insert(materials::value_mask(channel, axis), mean(2 + i));
+            }
+        }
+        for corner in 1..1usize << self.axes.len() {
+            masks.insert(materials::corner_mask(channel, &self.axes, corner), mean(2 + self.axes.len() + corner - 1));
+        }
+    }
 }
 
 impl Accumulator {
     fn new(width: u32, height: u32, used: &[UsedMaterial], asset: &Asset, geometry: &Geometry) -> Accumulator {
         let pixels = (width * height) as usize;
-        let textured = |m: &UsedMaterial| {
-            m.index
-                .and_then(|i| asset.document.materials().nth(i))
-                .is_some_and(|m| m.pbr_metallic_roughness().metallic_roughness_texture().is_some())
-        };
+        let textures = used
+            .iter()
+            .map(|m| {
+                let material = material_of(asset, m.index);
+                let axes = materials::map(asset, &material).axes;
+                let textured = material.pbr_metallic_roughness().metallic_roughness_texture().is_some();
+                (textured || !axes.is_empty()).then(|| TextureSums::new(&material, axes, pixels))
+            })
+            .collect();
         Accumulator {
             width,
             height,
@@ -509,7 +571,7 @@ impl Accumulator {
             vote: vec![(0, 0); pixels],
             material_hits: used.iter().map(|_| vec![0; pixels]).collect(),
             color: geometry.draws.iter().any(|d| d.has_colors).then(|| vec![Vec4::ZERO; pixels]),
-            metal_rough: used.iter().map(|m| textured(m).then(|| vec![[0.0; 4]; pixels])).collect(),
+            textures,
         }
     }
 
@@ -538,14 +600,8 @@ impl Accumulator {
             if let Some(color) = &mut self.color {
                 color[p] += Vec4::from(s.color[p]);
             }
-            if let Some(sums) = &mut self.metal_rough[slot] {
-                let [m, r] = s.metal_rough[p];
-                let dielectric = if m * r < 1.0 { (1.0 - m) * r / (1.0 - m * r) } else { 0.0 };
-                let sum = &mut sums[p];
-                sum[0] += m;
-                sum[1] += r;
-                sum[2] += dielectric;
-                sum[3] += m * r;
+            if let Some(sums) = &mut self.textures[slot] {
+                sums.add(p, s.metal_rough[p], s.base_color[p]);
             }
         }
     }
@@ -580,17 +636,8 @@ impl Accumulator {
         let mut masks = BTreeMap::new();
         for (slot, material) in used.iter().enumerate() {
             masks.insert(material.channel.clone(), share(&self.material_hits[slot]));
-            if let Some(sums) = &self.metal_rough[slot] {
-                // Over all the pixel's hits, not only this material's: the texture's value
-                // weighted by the material's share, so that at a pixel it shares with another
-                // material the texture's layers only take their part.
-                let mean = |k: usize| -> Vec<f32> {
-                    sums.iter().zip(&self.hits).map(|(s, &h)| if h > 0 { s[k] / h as f32 } else { 0.0 }).collect()
-                };
-                masks.insert(materials::metallic_mask(&material.channel), mean(0));
-                masks.insert(materials::roughness_mask(&material.channel), mean(1));
-                masks.insert(materials::rough_dielectric_mask(&material.channel), mean(2));
-                masks.insert(materials::rough_metal_mask(&material.channel), mean(3));
+            if let Some(sums) = &self.textures[slot] {
+                sums.masks(&material.channel, &self.hits, &mut masks);
             }
         }
         if let Some(color) = &self.color {

@@ -3,14 +3,14 @@
 //!
 //! The look has one stack, the default one, since every object of a baked asset tells its
 //! materials apart by mask rather than by id. The first material fills; each other material is a
-//! layer through its own mask; a material whose metallic-roughness texture varies adds the
-//! layers of [`TextureLayers`] right above its own.
+//! layer through its own mask, at the start of each of its texture [`Axis`]; a material with
+//! textured axes adds a corner layer for every other corner of their box right above its own.
 
 use super::geometry::primitives;
-use super::materials::{self, Mapped, TextureLayers, UsedMaterial};
+use super::materials::{self, Axis, Mapped, UsedMaterial};
 use super::Asset;
 use crate::material::look::{EnvironmentSettings, Layer, Look, ObjectStack, RenderSettings};
-use crate::material::params::{Param, Value};
+use crate::material::params::Param;
 use crate::material::Preset;
 use crate::{Error, Result};
 use std::path::{Component, Path, PathBuf};
@@ -39,12 +39,7 @@ impl Import {
         let materials = used
             .into_iter()
             .map(|used| {
-                let material = primitives
-                    .iter()
-                    .map(|(_, p)| p.material())
-                    .find(|m| m.index() == used.index)
-                    .expect("a used material belongs to a primitive");
-                let mapped = materials::map(asset, &material);
+                let mapped = materials::map(asset, &materials::material_of(asset, used.index));
                 let mut description = format!("'{}' from {source}.", used.label);
                 for note in &mapped.notes {
                     description.push_str(&format!(" {}{}.", note[..1].to_uppercase(), &note[1..]));
@@ -69,7 +64,9 @@ impl Import {
             let reference = preset_reference(&imported.preset.name);
             let params = imported.mapped.params;
             let channel = &imported.used.channel;
-            let layer = |mask: Option<String>, sets: &[(Param, f32)]| {
+            let axes = &imported.mapped.axes;
+            // The corner of the axes' box where the axes in `corner` are at their end.
+            let layer = |mask: Option<String>, corner: usize| {
                 let mut layer = Layer {
                     preset: Some(reference.clone()),
                     params,
@@ -80,30 +77,20 @@ impl Import {
                     enabled: true,
                     line: 0,
                 };
-                for &(param, value) in sets {
-                    layer.params.set(param, Value::Scalar(value)).expect("texture corners are in range");
-                    layer.overrides.push(param);
+                for (i, axis) in axes.iter().enumerate() {
+                    axis.apply(&mut layer.params, corner & (1 << i) != 0);
+                    layer.overrides.push(match axis {
+                        Axis::Metallic { .. } => Param::Metallic,
+                        Axis::Roughness { .. } => Param::Roughness,
+                        Axis::BaseColor { .. } => Param::BaseColor,
+                    });
                 }
+                layer.overrides.sort();
                 layer
             };
-            let own_mask = (rank > 0).then(|| channel.clone());
-            match imported.mapped.layers {
-                TextureLayers::None => layers.push(layer(own_mask, &[])),
-                TextureLayers::Metallic { factor } => {
-                    layers.push(layer(own_mask, &[(Param::Metallic, 0.0)]));
-                    layers.push(layer(Some(materials::metallic_mask(channel)), &[(Param::Metallic, factor)]));
-                }
-                TextureLayers::Roughness { factor } => {
-                    layers.push(layer(own_mask, &[(Param::Roughness, 0.0)]));
-                    layers.push(layer(Some(materials::roughness_mask(channel)), &[(Param::Roughness, factor)]));
-                }
-                TextureLayers::Both { metallic, roughness } => {
-                    let (m, r) = (Param::Metallic, Param::Roughness);
-                    layers.push(layer(own_mask, &[(m, 0.0), (r, 0.0)]));
-                    layers.push(layer(Some(materials::metallic_mask(channel)), &[(m, metallic), (r, 0.0)]));
-                    layers.push(layer(Some(materials::rough_dielectric_mask(channel)), &[(m, 0.0), (r, roughness)]));
-                    layers.push(layer(Some(materials::rough_metal_mask(channel)), &[(m, metallic), (r, roughness)]));
-                }
+            layers.push(layer((rank > 0).then(|| channel.clone()), 0));
+            for corner in 1..1usize << axes.len() {
+                layers.push(layer(Some(materials::corner_mask(channel, axes, corner)), corner));
             }
         }
         Look {
@@ -189,7 +176,7 @@ mod tests {
         params
     }
 
-    fn imported(channel: &str, base_color: [f32; 3], layers: TextureLayers) -> ImportedMaterial {
+    fn imported(channel: &str, base_color: [f32; 3], axes: Vec<Axis>) -> ImportedMaterial {
         let params = Params { base_color, metallic: 0.4, roughness: 0.3, ..Params::default() };
         ImportedMaterial {
             used: UsedMaterial {
@@ -198,7 +185,7 @@ mod tests {
                 channel: channel.into(),
                 preset: channel.into(),
             },
-            mapped: Mapped { params, layers, notes: Vec::new(), unsupported: Vec::new() },
+            mapped: Mapped { params, axes, notes: Vec::new(), unsupported: Vec::new() },
             preset: Preset {
                 name: channel.into(),
                 description: String::new(),
@@ -209,52 +196,67 @@ mod tests {
         }
     }
 
-    /// The bake's texture masks at a pixel wholly on the material, for texture values (m, r).
-    fn texture_masks(m: f32, r: f32) -> impl Fn(&str) -> f32 {
-        move |name: &str| match name.rsplit('.').next().unwrap() {
-            "paint" | "metal" => 1.0,
-            "metallic" => m,
-            "roughness" => r,
-            "rough_dielectric" if m * r < 1.0 => (1.0 - m) * r / (1.0 - m * r),
-            "rough_dielectric" => 0.0,
-            "rough_metal" => m * r,
-            other => panic!("unexpected mask {other}"),
+    /// The bake's corner masks at a pixel wholly on a material whose texels sit at `x` along
+    /// its axes.
+    fn texture_masks(channel: &'static str, axes: Vec<Axis>, x: Vec<f32>) -> impl Fn(&str) -> f32 {
+        let weights = materials::corner_weights(&x);
+        move |name: &str| {
+            if name == channel {
+                return 1.0;
+            }
+            (1..weights.len() + 1)
+                .find(|&corner| materials::corner_mask(channel, &axes, corner) == name)
+                .map(|corner| weights[corner - 1])
+                .unwrap_or(0.0)
         }
     }
 
     #[test]
-    fn texture_layers_reproduce_every_texel() {
-        for layers in [
-            TextureLayers::Metallic { factor: 0.9 },
-            TextureLayers::Roughness { factor: 0.8 },
-            TextureLayers::Both { metallic: 0.9, roughness: 0.8 },
-        ] {
+    fn corner_layers_reproduce_every_texel() {
+        let colour = Axis::BaseColor { from: [0.1, 0.2, 0.3], to: [0.7, 0.5, 0.4] };
+        let sets: Vec<Vec<Axis>> = vec![
+            vec![Axis::Metallic { factor: 0.9 }],
+            vec![Axis::Roughness { factor: 0.8 }],
+            vec![colour],
+            vec![Axis::Metallic { factor: 0.9 }, Axis::Roughness { factor: 0.8 }],
+            vec![Axis::Metallic { factor: 1.0 }, Axis::Roughness { factor: 0.5 }, colour],
+        ];
+        for axes in sets {
             let import =
-                Import { materials: vec![imported("paint", [0.8, 0.1, 0.1], layers)], unsupported: Vec::new() };
+                Import { materials: vec![imported("paint", [0.8, 0.1, 0.1], axes.clone())], unsupported: Vec::new() };
             let look = import.look(Path::new("look.toml"), str::to_string);
-            for (m, r) in [(0.0, 0.0), (1.0, 1.0), (0.25, 0.75), (0.9, 0.1), (0.5, 0.5)] {
-                let p = blend(&look, texture_masks(m, r));
-                let (want_m, want_r) = match layers {
-                    TextureLayers::Metallic { factor } => (factor * m, 0.3),
-                    TextureLayers::Roughness { factor } => (0.4, factor * r),
-                    TextureLayers::Both { metallic, roughness } => (metallic * m, roughness * r),
-                    TextureLayers::None => unreachable!(),
-                };
-                assert!((p.metallic - want_m).abs() < 1e-5, "{layers:?} at ({m}, {r}): metallic {}", p.metallic);
-                assert!((p.roughness - want_r).abs() < 1e-5, "{layers:?} at ({m}, {r}): roughness {}", p.roughness);
-                let colour_error =
-                    p.base_color.iter().zip([0.8, 0.1, 0.1]).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
-                assert!(colour_error < 1e-6, "the texture's layers leave the colour alone: {:?}", p.base_color);
+            assert_eq!(look.objects[0].layers.len(), 1 << axes.len());
+            for x in [0.0f32, 1.0, 0.25, 0.9, 0.5] {
+                // Each axis at a different place: x, 1 − x, then x².
+                let at: Vec<f32> = [x, 1.0 - x, x * x][..axes.len()].to_vec();
+                let p = blend(&look, texture_masks("paint", axes.clone(), at.clone()));
+                let mut want =
+                    Params { base_color: [0.8, 0.1, 0.1], metallic: 0.4, roughness: 0.3, ..Params::default() };
+                for (axis, &t) in axes.iter().zip(&at) {
+                    match *axis {
+                        Axis::Metallic { factor } => want.metallic = factor * t,
+                        Axis::Roughness { factor } => want.roughness = factor * t,
+                        Axis::BaseColor { from, to } => {
+                            want.base_color = [0, 1, 2].map(|k| from[k] + t * (to[k] - from[k]))
+                        }
+                    }
+                }
+                let error = (0..3)
+                    .map(|k| (p.base_color[k] - want.base_color[k]).abs())
+                    .chain([(p.metallic - want.metallic).abs(), (p.roughness - want.roughness).abs()])
+                    .fold(0.0, f32::max);
+                assert!(error < 1e-5, "{axes:?} at {at:?}: {p:?}");
             }
         }
     }
 
     #[test]
     fn each_material_shows_through_its_own_mask() {
+        let axes = vec![Axis::Metallic { factor: 1.0 }, Axis::Roughness { factor: 1.0 }];
         let import = Import {
             materials: vec![
-                imported("paint", [0.8, 0.1, 0.1], TextureLayers::None),
-                imported("metal", [0.9, 0.9, 0.9], TextureLayers::Both { metallic: 1.0, roughness: 1.0 }),
+                imported("paint", [0.8, 0.1, 0.1], Vec::new()),
+                imported("metal", [0.9, 0.9, 0.9], axes.clone()),
             ],
             unsupported: Vec::new(),
         };
@@ -262,12 +264,12 @@ mod tests {
         let layers = &look.objects[0].layers;
         assert_eq!(layers[0].mask, None, "the first material fills");
         assert_eq!(layers[1].mask.as_deref(), Some("metal"));
-        // On the paint: the metal's mask and its texture masks are 0 there.
+        // On the paint: the metal's mask and its corner masks are 0 there.
         let paint = blend(&look, |name| if name.starts_with("metal") { 0.0 } else { 1.0 });
         assert_eq!(paint.base_color, [0.8, 0.1, 0.1]);
         assert_eq!((paint.metallic, paint.roughness), (0.4, 0.3));
-        let metal = blend(&look, texture_masks(1.0, 0.5));
-        assert_eq!(metal.base_color, [0.9, 0.9, 0.9]);
+        let metal = blend(&look, texture_masks("metal", axes, vec![1.0, 0.5]));
+        assert!(metal.base_color.iter().all(|&c| (c - 0.9).abs() < 1e-6), "{metal:?}");
         assert!((metal.metallic - 1.0).abs() < 1e-6 && (metal.roughness - 0.5).abs() < 1e-6, "{metal:?}");
     }
 

@@ -1,10 +1,11 @@
 //! glTF materials as Disney 2012 parameters (README: lookdev import, where each formula is
 //! given), and what the bake needs to know of them.
 //!
-//! A preset holds constants, so a material's textures become either a constant (the texture's
-//! mean) or, for metallic and roughness, mask-driven layers that reproduce the texture exactly:
-//! the bake writes the texture's channels (and two products of them) as masks, and the look blends
-//! layers whose only difference is the textured parameter.
+//! A preset holds constants, so a material's textures become a constant (the texture's mean)
+//! and, where they vary, mask-driven layers: each textured parameter is an [`Axis`], the bake
+//! writes each texel's position along the axes and the weights of the corner layers as masks,
+//! and the look blends layers whose only difference is the textured parameters. Metallic and
+//! roughness are reproduced exactly; a base colour texture along its main colour axis.
 
 use super::names::{channel_name, unique};
 use super::Asset;
@@ -58,21 +59,105 @@ pub fn used(asset: &Asset, materials: impl IntoIterator<Item = Option<usize>>) -
         .collect()
 }
 
-/// The texture masks of a material with a metallic-roughness texture (README: lookdev bake).
-pub fn metallic_mask(channel: &str) -> String {
-    format!("{channel}.metallic")
+/// The material of this index, or glTF's default material for `None`.
+pub fn material_of(asset: &Asset, index: Option<usize>) -> gltf::Material<'_> {
+    match index {
+        Some(i) => asset.document.materials().nth(i).expect("material indices are validated"),
+        None => asset
+            .document
+            .meshes()
+            .flat_map(|m| m.primitives())
+            .map(|p| p.material())
+            .find(|m| m.index().is_none())
+            .expect("a primitive uses the default material"),
+    }
 }
-pub fn roughness_mask(channel: &str) -> String {
-    format!("{channel}.roughness")
+
+/// A texture-driven parameter the look carries through masks (README: Texture layers).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Axis {
+    /// metallic = factor × the texture's blue channel.
+    Metallic { factor: f32 },
+    /// roughness = factor × the texture's green channel.
+    Roughness { factor: f32 },
+    /// base_color = mix(from, to, t), with t the texel's position along the line from `from` to
+    /// `to`: the texture's main colour axis (its first principal component).
+    BaseColor { from: [f32; 3], to: [f32; 3] },
 }
-/// (1 − metallic)·roughness / (1 − metallic·roughness): the weight of the rough dielectric
-/// corner layer.
-pub fn rough_dielectric_mask(channel: &str) -> String {
-    format!("{channel}.rough_dielectric")
+
+impl Axis {
+    /// The word in mask names.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Axis::Metallic { .. } => "metallic",
+            Axis::Roughness { .. } => "roughness",
+            Axis::BaseColor { .. } => "base_color",
+        }
+    }
+
+    /// Sets the parameter to its value at the axis's start (`end` false) or end.
+    pub fn apply(&self, params: &mut Params, end: bool) {
+        match *self {
+            Axis::Metallic { factor } => params.metallic = if end { factor } else { 0.0 },
+            Axis::Roughness { factor } => params.roughness = if end { factor } else { 0.0 },
+            Axis::BaseColor { from, to } => params.base_color = if end { to } else { from },
+        }
+    }
+
+    /// Where a texel's value lies along the axis, in [0, 1]. `metal_rough` is the
+    /// metallic-roughness texel's (blue, green), `color` the base colour texel, linear and
+    /// multiplied by the factor.
+    pub fn position(&self, metal_rough: [f32; 2], color: [f32; 3]) -> f32 {
+        match *self {
+            Axis::Metallic { .. } => metal_rough[0],
+            Axis::Roughness { .. } => metal_rough[1],
+            Axis::BaseColor { from, to } => {
+                let direction = [0, 1, 2].map(|k| to[k] - from[k]);
+                let length2: f32 = direction.iter().map(|d| d * d).sum();
+                let along: f32 = (0..3).map(|k| (color[k] - from[k]) * direction[k]).sum();
+                if length2 > 0.0 {
+                    (along / length2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
 }
-/// metallic·roughness: the weight of the rough metal corner layer.
-pub fn rough_metal_mask(channel: &str) -> String {
-    format!("{channel}.rough_metal")
+
+/// The mask holding a texture's raw value along one axis: `<channel>.<axis>`.
+pub fn value_mask(channel: &str, axis: &Axis) -> String {
+    format!("{channel}.{}", axis.name())
+}
+
+/// The mask of the corner layer `corner` (a bit set over `axes`, never 0):
+/// `<channel>.layer_<axis>_<axis>…`, naming the axes at their end.
+pub fn corner_mask(channel: &str, axes: &[Axis], corner: usize) -> String {
+    let names: Vec<&str> =
+        axes.iter().enumerate().filter(|(i, _)| corner & (1 << i) != 0).map(|(_, a)| a.name()).collect();
+    format!("{channel}.layer_{}", names.join("_"))
+}
+
+/// The weights of the corner layers 1 .. 2^d at a texel whose positions along the `d` axes are
+/// `x`: each corner's multilinear share β_k = Π (x_i or 1 − x_i), over the shares of the
+/// corners stacked below it and itself, β_k / (β_0 + … + β_k). Blending the corners in order
+/// with these weights gives every axis its value exactly.
+pub fn corner_weights(x: &[f32]) -> Vec<f32> {
+    let corners = 1usize << x.len();
+    let share =
+        |k: usize| -> f32 { x.iter().enumerate().map(|(i, &v)| if k & (1 << i) != 0 { v } else { 1.0 - v }).product() };
+    let mut below = share(0);
+    (1..corners)
+        .map(|k| {
+            let beta = share(k);
+            below += beta;
+            if below > 0.0 {
+                beta / below
+            } else {
+                0.0
+            }
+        })
+        .collect()
 }
 
 /// KHR_materials_anisotropy.
@@ -102,28 +187,13 @@ pub fn anisotropy(material: &gltf::Material) -> Option<Anisotropy> {
     })
 }
 
-/// How a metallic-roughness texture is carried into the look.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum TextureLayers {
-    /// No texture, or one whose channels are constant (folded into the preset).
-    None,
-    /// Metallic varies: a layer with `metallic` = the factor, through `<channel>.metallic`, over
-    /// a base with metallic 0.
-    Metallic { factor: f32 },
-    /// Roughness varies: a layer with `roughness` = the factor, through `<channel>.roughness`.
-    Roughness { factor: f32 },
-    /// Both vary: three layers, the corners (factor, 0), (0, factor) and (factor, factor) of
-    /// (metallic, roughness) over a (0, 0) base, through `.metallic`, `.rough_dielectric` and
-    /// `.rough_metal`: bilinear interpolation, exact for every texel.
-    Both { metallic: f32, roughness: f32 },
-}
-
 /// A glTF material on the Disney parameters.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mapped {
     /// The preset: the best constant, with each texture at its mean.
     pub params: Params,
-    pub layers: TextureLayers,
+    /// The textured parameters the look carries through corner layers, in this order.
+    pub axes: Vec<Axis>,
     /// What the preset cannot hold, one sentence each.
     pub notes: Vec<String>,
     /// The extensions the material uses that lookdev ignores.
@@ -145,25 +215,74 @@ fn metal_rough_statistics(image: &image::RgbaImage) -> [(f32, f32, f32); 2] {
     stats.map(|(sum, min, max)| ((sum / n) as f32, min, max))
 }
 
-/// The mean linear colour of an sRGB-encoded texture.
-fn mean_linear_color(image: &image::RgbaImage) -> [f32; 3] {
-    let decode = |c: u8| {
-        let c = c as f64 / 255.0;
-        if c <= 0.04045 {
-            c / 12.92
-        } else {
-            ((c + 0.055) / 1.055).powf(2.4)
-        }
-    };
-    let table: Vec<f64> = (0..=255u8).map(decode).collect();
+/// sRGB-encoded 8-bit values decoded to linear, as a table.
+pub fn srgb_decode_table() -> [f32; 256] {
+    std::array::from_fn(|i| {
+        let c = i as f64 / 255.0;
+        (if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }) as f32
+    })
+}
+
+/// What a base colour texture (times its factor) holds: its mean linear colour, and its main
+/// colour axis when its colours vary.
+struct ColorStatistics {
+    mean: [f32; 3],
+    /// The axis's ends: the texels projected onto the first principal component span them.
+    axis: Option<([f32; 3], [f32; 3])>,
+    /// The share of the colours' variance along the axis.
+    explained: f32,
+}
+
+/// A colour spread less than this along the main axis (linear units) is a constant.
+const COLOR_VARIATION: f32 = 0.01;
+
+fn color_statistics(image: &image::RgbaImage, factor: [f32; 3]) -> ColorStatistics {
+    let table = srgb_decode_table();
+    let texel = |p: &image::Rgba<u8>| [0, 1, 2].map(|k| (table[p.0[k] as usize] * factor[k]) as f64);
+    let n = (image.width() as f64 * image.height() as f64).max(1.0);
     let mut sum = [0.0f64; 3];
-    for pixel in image.pixels() {
-        for k in 0..3 {
-            sum[k] += table[pixel.0[k] as usize];
+    for p in image.pixels() {
+        let c = texel(p);
+        (0..3).for_each(|k| sum[k] += c[k]);
+    }
+    let mean = sum.map(|s| s / n);
+    let mut covariance = [[0.0f64; 3]; 3];
+    for p in image.pixels() {
+        let c = texel(p);
+        for i in 0..3 {
+            for j in 0..3 {
+                covariance[i][j] += (c[i] - mean[i]) * (c[j] - mean[j]) / n;
+            }
         }
     }
-    let n = (image.width() as f64 * image.height() as f64).max(1.0);
-    sum.map(|s| (s / n) as f32)
+    // The first principal component, by power iteration from the diagonal's largest axis.
+    let trace = covariance[0][0] + covariance[1][1] + covariance[2][2];
+    let start = (0..3).max_by(|&a, &b| covariance[a][a].total_cmp(&covariance[b][b])).unwrap_or(0);
+    let mut e = [0.0f64; 3];
+    e[start] = 1.0;
+    for _ in 0..64 {
+        let next: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| covariance[i][j] * e[j]).sum());
+        let length = next.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if length == 0.0 {
+            break;
+        }
+        e = next.map(|v| v / length);
+    }
+    let along = |c: [f64; 3]| (0..3).map(|k| (c[k] - mean[k]) * e[k]).sum::<f64>();
+    let (mut low, mut high) = (f64::MAX, f64::MIN);
+    for p in image.pixels() {
+        let t = along(texel(p));
+        low = low.min(t);
+        high = high.max(t);
+    }
+    let variance_along: f64 = (0..3).map(|i| (0..3).map(|j| e[i] * covariance[i][j] * e[j]).sum::<f64>()).sum();
+    let point = |t: f64| [0, 1, 2].map(|k| (mean[k] + t * e[k]).clamp(0.0, 1.0) as f32);
+    let spread = (high - low) as f32;
+    ColorStatistics {
+        mean: mean.map(|m| m as f32),
+        axis: (spread > COLOR_VARIATION).then(|| (point(low), point(high))),
+        explained: if trace > 0.0 { (variance_along / trace) as f32 } else { 1.0 },
+    }
 }
 
 fn luminance(c: [f32; 3]) -> f32 {
@@ -176,30 +295,36 @@ pub fn map(asset: &Asset, material: &gltf::Material) -> Mapped {
     let pbr = material.pbr_metallic_roughness();
     let factor = pbr.base_color_factor();
     let mut base_color = [factor[0], factor[1], factor[2]];
-    if let Some(info) = pbr.base_color_texture() {
-        let mean = mean_linear_color(asset.texture_image(&info.texture()));
-        base_color = [0, 1, 2].map(|k| base_color[k] * mean[k]);
-        notes.push("base_color is the base colour factor times the texture's mean colour".into());
-    }
+    let mut axes = Vec::new();
     let (metallic_factor, roughness_factor) = (pbr.metallic_factor(), pbr.roughness_factor());
     let (mut metallic, mut roughness) = (metallic_factor, roughness_factor);
-    let mut layers = TextureLayers::None;
     if let Some(info) = pbr.metallic_roughness_texture() {
         let [(metal_mean, metal_min, metal_max), (rough_mean, rough_min, rough_max)] =
             metal_rough_statistics(asset.texture_image(&info.texture()));
         metallic *= metal_mean;
         roughness *= rough_mean;
-        let (metal_varies, rough_varies) = (metal_max - metal_min > VARIATION, rough_max - rough_min > VARIATION);
-        layers = match (metal_varies, rough_varies) {
-            (false, false) => TextureLayers::None,
-            (true, false) => TextureLayers::Metallic { factor: metallic_factor },
-            (false, true) => TextureLayers::Roughness { factor: roughness_factor },
-            (true, true) => TextureLayers::Both { metallic: metallic_factor, roughness: roughness_factor },
-        };
-        if layers != TextureLayers::None {
+        if metal_max - metal_min > VARIATION {
+            axes.push(Axis::Metallic { factor: metallic_factor });
+        }
+        if rough_max - rough_min > VARIATION {
+            axes.push(Axis::Roughness { factor: roughness_factor });
+        }
+        if !axes.is_empty() {
             notes.push(
-                "metallic and roughness are the texture's means; the look layers the texture in through masks".into(),
+                "the preset holds the metallic-roughness texture's means; the look layers the texture in through masks"
+                    .into(),
             );
+        }
+    }
+    if let Some(info) = pbr.base_color_texture() {
+        let statistics = color_statistics(asset.texture_image(&info.texture()), base_color);
+        base_color = statistics.mean;
+        if let Some((from, to)) = statistics.axis {
+            axes.push(Axis::BaseColor { from, to });
+            notes.push(format!(
+                "the preset holds the base colour texture's mean; the look layers the texture in along its main colour axis, which holds {:.0}% of its variance",
+                100.0 * statistics.explained
+            ));
         }
     }
 
@@ -276,7 +401,7 @@ pub fn map(asset: &Asset, material: &gltf::Material) -> Mapped {
     for name in &unsupported {
         notes.push(format!("{name} is not supported"));
     }
-    Mapped { params: clamp_params(params), layers, notes, unsupported }
+    Mapped { params: clamp_params(params), axes, notes, unsupported }
 }
 
 /// Disney's anisotropic, from KHR_materials_anisotropy's strength s at GGX alpha α: the same

@@ -36,6 +36,8 @@ pub struct DeviceInfo {
     /// Nanoseconds per timestamp tick, or None when the queue cannot write timestamps.
     pub timestamp_period_ns: Option<f64>,
     pub max_image_dimension_2d: u32,
+    /// How many colour targets one draw may write.
+    pub max_color_attachments: u32,
     pub max_image_array_layers: u32,
     pub subgroup_size: u32,
 }
@@ -450,6 +452,7 @@ fn candidates(
             device_type: props.device_type,
             timestamp_period_ns: timestamps.then_some(props.limits.timestamp_period as f64),
             max_image_dimension_2d: props.limits.max_image_dimension2_d,
+            max_color_attachments: props.limits.max_color_attachments,
             max_image_array_layers: props.limits.max_image_array_layers,
             subgroup_size: subgroup.subgroup_size,
         };
