@@ -27,6 +27,9 @@ layout(location = 4) out vec4 out_color;        // COLOR_0
 layout(location = 5) out vec2 out_metal_rough;  // the texture's B (metallic) and G (roughness)
 layout(location = 6) out vec4 out_base_color;   // the base colour texture, linear; white without one
 
+// The least N·V a shading normal keeps.
+const float MIN_FACING = 0.01;
+
 vec2 texcoord(uint set) {
     return set == 1u ? uv1 : uv0;
 }
@@ -59,11 +62,19 @@ void main() {
         m.xy *= draw.normal_scale;
         shading = normalize(m.x * t + m.y * b + m.z * n);
     }
+    vec3 view = draw.eye.w > 0.5 ? normalize(draw.eye.xyz - world_position) : draw.toward_eye.xyz;
+    // A normal map (or smooth normals at a silhouette) can turn the shading normal away from the
+    // eye, where the BRDF is zero and the pixel would shade black: bend it back just past the
+    // silhouette, toward the eye.
+    float facing = dot(shading, view);
+    if (facing < MIN_FACING) {
+        vec3 across = shading - view * facing;
+        shading = dot(across, across) > 1e-12 ? normalize(normalize(across) + MIN_FACING * view) : n;
+    }
     // The tangent of the shading frame, turned toward the material's anisotropy direction.
     vec3 anisotropy = draw.anisotropy_cos * t + draw.anisotropy_sin * b;
     vec3 tangent = anisotropy - shading * dot(shading, anisotropy);
     tangent = dot(tangent, tangent) > 1e-12 ? normalize(tangent) : vec3(0.0);
-    vec3 view = draw.eye.w > 0.5 ? normalize(draw.eye.xyz - world_position) : draw.toward_eye.xyz;
     vec2 metal_rough = vec2(0.0);
     if ((draw.flags & DRAW_METAL_ROUGH_MAP) != 0u) {
         vec4 texel = texture(metal_rough_map, texcoord(uv_set(2u)));

@@ -667,3 +667,27 @@ fn alpha_masked_materials_cut_out_what_is_below_the_cutoff() {
         assert_eq!((drawn(8), drawn(24)), (expect_left, expect_right), "factor alpha {factor}");
     }
 }
+
+#[test]
+fn shading_normals_that_a_normal_map_turns_away_from_the_eye_are_bent_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let (image, _) = quadrant_normal_map();
+    let mut gltf = Gltf::new();
+    let texture = gltf.texture(&image);
+    let material = gltf.material(json!({ "name": "bumpy", "normalTexture": { "index": texture } }));
+    let mesh = gltf.mesh("plane", &[(&plane(1.0), Some(material))]);
+    gltf.node(json!({ "name": "plane", "mesh": mesh }));
+    let path = gltf.write_gltf(dir.path(), "grazing");
+    // Seen from 80° off the plane's normal, from below: the quadrants tilted down face away.
+    let ctx = common::gpu::graphics_context();
+    let asset = Asset::load(&path).unwrap();
+    let camera = CameraChoice::Frame { yaw_degrees: 0.0, pitch_degrees: -80.0, fov_degrees: 30.0 };
+    let g = bake(&ctx, &asset, &BakeOptions { width: 48, height: 48, samples: 4, camera }, |_, _, _| {}).unwrap();
+    common::gpu::finish(ctx);
+    let covered: Vec<usize> = (0..g.coverage.len()).filter(|&p| g.coverage[p] > 0.0).collect();
+    assert!(covered.len() > 100, "{} covered pixels", covered.len());
+    for p in covered {
+        let (n, v) = (Vec3::from(g.normal[p]), Vec3::from(g.view[p]));
+        assert!(n.dot(v) > 0.0, "pixel {p}: N·V = {}", n.dot(v));
+    }
+}
