@@ -4,6 +4,7 @@
 
 mod common;
 
+use common::cli::{assert_bad_input, assert_success, lookdev, stderr};
 use common::gltf::{camera_looking_down_z, cube, plane, uv_sphere, Gltf, Mesh};
 use glam::{Mat3, Quat, Vec3};
 use lookdev::asset::bake::{bake, BakeOptions};
@@ -13,7 +14,6 @@ use lookdev::asset::Asset;
 use lookdev::gbuffer::GBuffer;
 use serde_json::json;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 fn bake_file(path: &Path, size: u32, samples: u32) -> GBuffer {
     let ctx = common::gpu::graphics_context();
@@ -361,18 +361,6 @@ fn vertex_colours_and_textures_become_masks_and_layers_that_reproduce_every_texe
     }
 }
 
-fn lookdev(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lookdev")).args(args).env("LOOKDEV_VALIDATION", "1").output().unwrap()
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
-fn assert_success(output: &Output) {
-    assert!(output.status.success(), "failed: {}", stderr(output));
-}
-
 #[test]
 fn the_mapping_holds_for_every_listed_extension_and_unsupported_ones_are_named() {
     let dir = tempfile::tempdir().unwrap();
@@ -434,14 +422,17 @@ fn the_mapping_holds_for_every_listed_extension_and_unsupported_ones_are_named()
 
     // The CLI writes the preset and the look, and warns of the extension it ignores.
     let (presets, look) = (dir.path().join("presets"), dir.path().join("lacquer.toml"));
-    let output = lookdev(&[
-        "import",
-        path.to_str().unwrap(),
-        "--presets",
-        presets.to_str().unwrap(),
-        "--look",
-        look.to_str().unwrap(),
-    ]);
+    let import = || {
+        lookdev(&[
+            "import",
+            path.to_str().unwrap(),
+            "--presets",
+            presets.to_str().unwrap(),
+            "--look",
+            look.to_str().unwrap(),
+        ])
+    };
+    let output = import();
     assert_success(&output);
     assert!(
         stderr(&output).contains("warning") && stderr(&output).contains("KHR_materials_transmission"),
@@ -453,14 +444,7 @@ fn the_mapping_holds_for_every_listed_extension_and_unsupported_ones_are_named()
     let look_text = std::fs::read_to_string(&look).unwrap();
     assert!(look_text.contains("preset = \"presets/lacquer_01.toml\""), "{look_text}");
     // Importing again without --force refuses, and leaves the files as they were.
-    let again = lookdev(&[
-        "import",
-        path.to_str().unwrap(),
-        "--presets",
-        presets.to_str().unwrap(),
-        "--look",
-        look.to_str().unwrap(),
-    ]);
+    let again = import();
     assert_eq!(again.status.code(), Some(2), "{}", stderr(&again));
     assert!(stderr(&again).contains("already exists"), "{}", stderr(&again));
     assert_eq!(std::fs::read_to_string(&look).unwrap(), look_text);
@@ -565,18 +549,6 @@ fn baking_and_rendering_a_gltf_sphere_matches_the_built_in_analytic_sphere() {
     let bias = (sum_baked - sum_analytic) / sum_analytic;
     assert!(bias.abs() < 0.01, "the baked ball is {:.2}% brighter", bias * 100.0);
     assert!(mean_difference < 0.03, "per-pixel difference {:.2}%", mean_difference * 100.0);
-}
-
-/// Exit code 2 and one error line naming the file and the problem.
-fn assert_bad_input(output: &Output, fragments: &[&str]) {
-    let text = stderr(output);
-    assert_eq!(output.status.code(), Some(2), "expected exit code 2, got {:?}: {text}", output.status.code());
-    assert!(!text.contains("panicked"), "{text}");
-    let errors: Vec<&str> = text.lines().filter(|l| l.starts_with("lookdev: error:")).collect();
-    assert_eq!(errors.len(), 1, "expected one error line: {text}");
-    for fragment in fragments {
-        assert!(errors[0].contains(fragment), "error line lacks '{fragment}': {}", errors[0]);
-    }
 }
 
 /// A one-sphere asset, changed by `edit` before it is written as `<name>.gltf`.

@@ -3,33 +3,10 @@
 
 mod common;
 
+use common::cli::{assert_bad_input, assert_success, lookdev, stderr};
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn lookdev(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lookdev")).args(args).env("LOOKDEV_VALIDATION", "1").output().unwrap()
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
-fn assert_success(output: &Output) {
-    assert!(output.status.success(), "failed: {}", stderr(output));
-    assert!(!stderr(output).contains("validation error"), "{}", stderr(output));
-}
-
-/// Exit code 2 and one line on stderr that contains every fragment (file name, problem).
-fn assert_bad_input(output: &Output, fragments: &[&str]) {
-    let text = stderr(output);
-    assert_eq!(output.status.code(), Some(2), "expected exit code 2, got {:?}: {text}", output.status.code());
-    assert!(!text.contains("panicked"), "{text}");
-    let errors: Vec<&str> = text.lines().filter(|l| l.starts_with("lookdev: error:")).collect();
-    assert_eq!(errors.len(), 1, "expected one error line: {text}");
-    for fragment in fragments {
-        assert!(errors[0].contains(fragment), "error line lacks '{fragment}': {}", errors[0]);
-    }
-}
+use std::process::Command;
 
 struct Workspace {
     dir: tempfile::TempDir,

@@ -100,29 +100,25 @@ impl Buffer {
 
     /// A device-local storage buffer holding `data`.
     pub fn with_data(ctx: &Context, data: &[u8]) -> Result<Buffer> {
-        let buffer = Buffer::storage(ctx, data.len() as u64)?;
-        let mut staging = Buffer::staging(ctx, data.len() as u64)?;
-        staging.bytes_mut()[..data.len()].copy_from_slice(data);
-        ctx.run(|cmd| {
-            let region = vk::BufferCopy::default().size(data.len().max(1) as u64);
-            unsafe { ctx.device.cmd_copy_buffer(cmd, staging.buffer, buffer.buffer, &[region]) };
-            Ok(())
-        })?;
-        Ok(buffer)
+        Buffer::storage(ctx, data.len() as u64)?.fill(ctx, data)
     }
 
     /// A device-local vertex buffer holding `data`.
     pub fn vertices(ctx: &Context, data: &[u8]) -> Result<Buffer> {
         let usage = vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
-        let buffer = Buffer::new(ctx, data.len() as u64, usage, false)?;
+        Buffer::new(ctx, data.len() as u64, usage, false)?.fill(ctx, data)
+    }
+
+    /// Copies `data` into this device-local buffer through a staging buffer.
+    fn fill(self, ctx: &Context, data: &[u8]) -> Result<Buffer> {
         let mut staging = Buffer::staging(ctx, data.len() as u64)?;
         staging.bytes_mut()[..data.len()].copy_from_slice(data);
         ctx.run(|cmd| {
             let region = vk::BufferCopy::default().size(data.len().max(1) as u64);
-            unsafe { ctx.device.cmd_copy_buffer(cmd, staging.buffer, buffer.buffer, &[region]) };
+            unsafe { ctx.device.cmd_copy_buffer(cmd, staging.buffer, self.buffer, &[region]) };
             Ok(())
         })?;
-        Ok(buffer)
+        Ok(self)
     }
 
     /// Copies the whole buffer back to the host.

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod albedo;
+pub mod cli;
 pub mod gltf;
 pub mod golden;
 pub mod gpu;
