@@ -663,3 +663,51 @@ fn shading_normals_that_a_normal_map_turns_away_from_the_eye_are_bent_back() {
         assert!(n.dot(v) > 0.0, "pixel {p}: N·V = {}", n.dot(v));
     }
 }
+
+#[test]
+fn the_named_camera_an_orthographic_camera_and_framing_each_look_where_they_should() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut gltf = Gltf::new();
+    let mesh = gltf.mesh("sphere", &[(&uv_sphere(1.0, 32, 16), None)]);
+    gltf.node(json!({ "name": "ball", "mesh": mesh }));
+    camera_looking_down_z(&mut gltf, "front", [0.0, 0.0, 6.0], 30.0, 1.0);
+    // From +X, looking down −X: the camera's −Z turned 90° about +Y.
+    let side = gltf.camera(json!({ "name": "side-lens", "type": "orthographic",
+        "orthographic": { "xmag": 1.5, "ymag": 1.5, "znear": 0.1, "zfar": 20.0 } }));
+    let turn = Quat::from_rotation_y(std::f32::consts::FRAC_PI_2);
+    gltf.node(json!({ "name": "side", "camera": side, "translation": [6.0, 0.0, 0.0], "rotation": turn.to_array() }));
+    let path = gltf.write_gltf(dir.path(), "cameras");
+    let asset = Asset::load(&path).unwrap();
+    let ctx = common::gpu::graphics_context();
+    let size = 33;
+    let centre = (size / 2 * size + size / 2) as usize;
+    let mut bake_with = |camera: CameraChoice| {
+        bake(&ctx, &asset, &BakeOptions { width: size, height: size, samples: 1, camera }, |_, _, _| {}).unwrap()
+    };
+    // The scene's first camera by default, and the same by name.
+    for choice in [CameraChoice::Default, CameraChoice::Named("front".into())] {
+        let g = bake_with(choice);
+        assert!(angle_degrees(Vec3::from(g.view[centre]), Vec3::Z) < 0.5);
+        assert!(angle_degrees(Vec3::from(g.normal[centre]), Vec3::Z) < 2.0);
+    }
+    // The orthographic camera by its camera's name: every view vector is +X, and the sphere of
+    // radius 1 fills 2/3 of a frame 3 units high.
+    let g = bake_with(CameraChoice::Named("side-lens".into()));
+    let covered: Vec<usize> = (0..g.coverage.len()).filter(|&p| g.coverage[p] == 1.0).collect();
+    assert!(covered.iter().all(|&p| angle_degrees(Vec3::from(g.view[p]), Vec3::X) < 0.01));
+    let expected = std::f32::consts::PI * (size as f32 / 3.0).powi(2);
+    assert!(
+        (covered.len() as f32 - expected).abs() < 0.1 * expected,
+        "{} covered pixels, about {expected} expected",
+        covered.len()
+    );
+    // Framing from yaw 90° looks from +X; from pitch 60° down onto the top.
+    for (yaw, pitch, toward) in [(90.0, 0.0, Vec3::X), (0.0, 60.0, Vec3::new(0.0, 60f32.to_radians().sin(), 0.5))] {
+        let g = bake_with(CameraChoice::Frame { yaw_degrees: yaw, pitch_degrees: pitch, fov_degrees: 30.0 });
+        assert!(angle_degrees(Vec3::from(g.view[centre]), toward) < 0.5, "yaw {yaw}, pitch {pitch}");
+        // The sphere touches the frame's edges: the middle row is covered from edge to edge.
+        let row = size as usize / 2;
+        assert!(g.coverage[row * size as usize + 1] > 0.0 && g.coverage[row * size as usize + size as usize - 2] > 0.0);
+    }
+    common::gpu::finish(ctx);
+}

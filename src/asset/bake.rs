@@ -176,6 +176,8 @@ struct Rasterizer {
     targets: Vec<Image>,
     depth: Image,
     staging: Buffer,
+    /// Where each target's copy starts in `staging`.
+    offsets: Vec<u64>,
     // Held so the texture sets' images and samplers stay alive.
     _textures: Vec<Image>,
     _samplers: Vec<Sampler>,
@@ -234,7 +236,14 @@ impl Rasterizer {
             .map(|&format| Image::color_target(ctx, format, width, height))
             .collect::<Result<Vec<_>>>()?;
         let depth = Image::depth_target(ctx, width, height)?;
-        let staging = Buffer::staging(ctx, targets.iter().map(Image::byte_size).sum())?;
+        // Each target's copy starts on a 16-byte boundary: copies must start on a whole texel.
+        let mut offsets = Vec::new();
+        let mut end = 0u64;
+        for target in &targets {
+            offsets.push(end);
+            end = (end + target.byte_size()).next_multiple_of(16);
+        }
+        let staging = Buffer::staging(ctx, end)?;
 
         // Textures, each image and sampler made once however many materials share it.
         let mut textures: Vec<Image> = Vec::new();
@@ -334,6 +343,7 @@ impl Rasterizer {
             targets,
             depth,
             staging,
+            offsets,
             _textures: textures,
             _samplers: samplers,
         })
@@ -406,20 +416,17 @@ impl Rasterizer {
             }
             unsafe { device.cmd_end_rendering(cmd) };
             crate::gpu::context::full_barrier(device, cmd);
-            let mut offset = 0;
-            for target in &self.targets {
+            for (target, &offset) in self.targets.iter().zip(&self.offsets) {
                 target.record_read_at(cmd, &self.staging, offset);
-                offset += target.byte_size();
             }
             Ok(())
         })?;
         let bytes = self.staging.bytes();
         let pixels = (width * height) as usize;
-        let mut at = 0usize;
+        let mut targets = self.offsets.iter().map(|&offset| offset as usize);
         let mut next = |texel: usize| {
-            let slice = &bytes[at..at + pixels * texel];
-            at += pixels * texel;
-            slice
+            let at = targets.next().expect("one offset per target");
+            &bytes[at..at + pixels * texel]
         };
         Ok(Samples {
             normal: bytemuck::cast_slice(next(16)),
