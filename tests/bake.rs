@@ -681,7 +681,7 @@ fn the_named_camera_an_orthographic_camera_and_framing_each_look_where_they_shou
     let ctx = common::gpu::graphics_context();
     let size = 33;
     let centre = (size / 2 * size + size / 2) as usize;
-    let mut bake_with = |camera: CameraChoice| {
+    let bake_with = |camera: CameraChoice| {
         bake(&ctx, &asset, &BakeOptions { width: size, height: size, samples: 1, camera }, |_, _, _| {}).unwrap()
     };
     // The scene's first camera by default, and the same by name.
