@@ -61,7 +61,7 @@ fn unknown_keys_name_the_table_and_the_expected_keys() {
     );
     assert_eq!(
         error("# a look\ncolour = 1\n"),
-        "looks/shot.toml:2: unknown key 'colour' at the top level (expected environment, render, object)"
+        "looks/shot.toml:2: unknown key 'colour' at the top level (expected environment, render, model, object)"
     );
     assert_eq!(
         error("[[object]]\nid = 1\n[[object.layer]]\npreset = \"gold\"\nmaks = \"stripes\"\n"),
@@ -500,4 +500,41 @@ fn tables_of_the_wrong_shape_are_named() {
         error("[object]\nid = 1\n"),
         "looks/shot.toml:1: [object]: invalid type: map, expected a sequence (a list of tables is written [[name]])"
     );
+}
+
+// ---- The [model] table. ----
+
+#[test]
+fn model_table_parses_reads_back_and_names_bad_values() {
+    use lookdev::shading::model::{Diffuse, Fresnel, Model, SpecularD, SpecularG};
+    let text = "[model]\ndiffuse = \"oren-nayar\"\nspecular_d = \"gtr\"\ngtr_gamma = 1.5\n\
+                specular_g = \"smith-height-correlated\"\nfresnel = \"conductor\"\nenergy_compensation = true\n";
+    let look = Look::parse(text, Path::new(SHOT)).unwrap();
+    let model = look.model.unwrap();
+    assert_eq!(model.diffuse, Diffuse::OrenNayar);
+    assert_eq!(model.specular_d, SpecularD::Gtr);
+    assert_eq!(model.specular_g, SpecularG::SmithHeightCorrelated);
+    assert_eq!(model.fresnel, Fresnel::Conductor);
+    assert_eq!(model.gtr_gamma, 1.5);
+    assert!(model.energy_compensation);
+    // Written back, it reads back equal.
+    let again = Look::parse(&look.to_toml(), Path::new(SHOT)).unwrap();
+    assert_eq!(again.model, Some(model));
+    // No table: no model; an empty table: the default model.
+    assert_eq!(Look::parse("", Path::new(SHOT)).unwrap().model, None);
+    assert_eq!(Look::parse("[model]\n", Path::new(SHOT)).unwrap().model, Some(Model::default()));
+
+    assert_eq!(
+        error("[model]\n\ndiffuse = \"lambret\"\n"),
+        "looks/shot.toml:3: diffuse = 'lambret' is not a model (expected burley2012, lambert, frostbite, oren-nayar, \
+         oren-nayar-qualitative, oren-nayar-fujii, gotanda, hammon); did you mean 'lambert'?"
+    );
+    let message = error("[model]\nspecular = \"gtr\"\n");
+    assert!(message.starts_with("looks/shot.toml:2: unknown model key 'specular'"), "{message}");
+    assert_eq!(error("[model]\ngtr_gamma = 20\n"), "looks/shot.toml:2: gtr_gamma = 20 is out of range [0.5, 10]");
+    assert_eq!(
+        error("[model]\nenergy_compensation = 1\n"),
+        "looks/shot.toml:2: energy_compensation takes true or false"
+    );
+    assert_eq!(error("[model]\nfresnel = 2\n"), "looks/shot.toml:2: fresnel takes a name in quotes");
 }

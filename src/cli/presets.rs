@@ -217,7 +217,7 @@ fn sheet(args: SheetArgs) -> Result<()> {
     if args.lighting.env.is_some() {
         base.environment = Default::default();
     }
-    let sampling = SamplingArgs { spp: Some(args.spp), seed: None };
+    let sampling = SamplingArgs { spp: Some(args.spp), ..SamplingArgs::default() };
     let settings = Settings::resolve(&base, &inputs::overrides(&args.lighting, &sampling, &args.display))?;
     let environment = match &settings.environment {
         Some(path) => environment::load::load(path, &args.lighting.load_options())?,
