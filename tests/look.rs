@@ -253,6 +253,7 @@ fn presets_round_trip_through_toml() {
         tags: vec![],
         params: Params { roughness: 0.1, ..Params::default() },
         set: vec![Param::Roughness],
+        ior: None,
     };
     assert_eq!(Preset::parse(&odd.to_toml(), Path::new("odd.toml")).unwrap(), odd);
 }
@@ -537,4 +538,21 @@ fn model_table_parses_reads_back_and_names_bad_values() {
         "looks/shot.toml:2: energy_compensation takes true or false"
     );
     assert_eq!(error("[model]\nfresnel = 2\n"), "looks/shot.toml:2: fresnel takes a name in quotes");
+}
+
+#[test]
+fn preset_complex_ior_must_match_its_base_color() {
+    let file = Path::new("presets/metal.toml");
+    let ok = "base_color = [0.9626, 0.8276, 0.4082]\nior_n = [0.14, 0.31, 1.38]\nior_k = [3.697, 2.34, 1.914]\n";
+    let preset = Preset::parse(ok, file).unwrap();
+    assert_eq!(preset.ior, Some(([0.14, 0.31, 1.38], [3.697, 2.34, 1.914])));
+    assert!(preset.params.ior_edge.iter().all(|&e| e > 0.0 && e <= 1.0));
+    assert_eq!(Preset::parse(&preset.to_toml(), file).unwrap(), preset);
+    let bad = |text: &str| Preset::parse(text, file).unwrap_err().to_string();
+    assert_eq!(bad("ior_n = [1, 1, 1]\n"), "presets/metal.toml:1: ior_n needs ior_k beside it");
+    assert_eq!(
+        bad("base_color = [0.5, 0.8276, 0.4082]\nior_n = [0.14, 0.31, 1.38]\nior_k = [3.697, 2.34, 1.914]\n"),
+        "presets/metal.toml:2: base_color[0] = 0.5 is not the F0 0.9626 of ior_n and ior_k (within 0.005)"
+    );
+    assert_eq!(bad("ior_n = [0, 1, 1]\nior_k = [0, 0, 0]\n"), "presets/metal.toml:1: ior_n[0] = 0 must be in (0, 100]");
 }
