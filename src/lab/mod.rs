@@ -6,6 +6,9 @@
 //! - [`slice_directions`]: BRDF Explorer's (θh, θd, φd) parameterisation (Rusinkiewicz 1998);
 //! - [`in_plane`]: the lobe in the plane of incidence.
 
+pub mod furnace;
+pub mod plot;
+
 use crate::material::Params;
 use crate::shading::brdf::{disney_brdf, make_half_vector, make_lobes_with, make_view, Lobes, Shading, View};
 use crate::shading::sampling::{
