@@ -198,6 +198,11 @@ fn bad_plot_input_is_one_line_with_exit_code_2() {
         (vec!["brdf", "albedo", "--preset", "no-such", "--out", "x.svg"], "--preset no-such: no preset named"),
         (vec!["brdf", "furnace", "--metallic", "2", "--out", "x.png"], "--metallic: values must be in [0, 1]"),
         (vec!["brdf", "albedo", "--model", "gtr_gamma=99", "--out", "x.svg"], "out of range"),
+        (
+            vec!["render", "--model", "fresnel=exact", "--out", "x.png"],
+            "--model fresnel=exact: fresnel = 'exact' is not a model",
+        ),
+        (vec!["render", "--model", "energy_compensation", "--out", "x.png"], "expected KEY=VALUE"),
     ] {
         let output = lookdev(&args);
         let stderr = String::from_utf8_lossy(&output.stderr);
