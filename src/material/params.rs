@@ -286,9 +286,12 @@ mod tests {
         for p in Param::ALL {
             assert_eq!(Param::from_name(p.name()), Some(p));
         }
-        let mut params = Params::default();
-        params.base_color = [0.1, 0.2, 0.3];
-        params.clearcoat_gloss = 0.7;
+        let params = Params {
+            base_color: [0.1, 0.2, 0.3],
+            clearcoat_gloss: 0.7,
+            ior_edge: [0.2, 0.4, 0.6],
+            ..Params::default()
+        };
         assert_eq!(Params::from_gpu(&params.to_gpu()), params);
     }
 
@@ -309,9 +312,7 @@ mod tests {
     #[test]
     fn mix_is_per_parameter() {
         let a = Params::default();
-        let mut b = Params::default();
-        b.roughness = 0.1;
-        b.base_color = [1.0, 0.0, 0.0];
+        let b = Params { roughness: 0.1, base_color: [1.0, 0.0, 0.0], ..Params::default() };
         let m = a.mix(&b, 0.5);
         assert!((m.roughness - 0.3).abs() < 1e-6);
         assert!((m.base_color[0] - 0.9).abs() < 1e-6 && (m.base_color[1] - 0.4).abs() < 1e-6);

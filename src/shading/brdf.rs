@@ -297,6 +297,7 @@ pub fn smith_g_aniso(w: Vec3, ax: f32, ay: f32) -> f32 {
 }
 
 /// erfc(x)·e^(x²) for x ≥ 0 (Abramowitz and Stegun 7.1.26).
+#[allow(clippy::excessive_precision)] // the coefficients as Abramowitz and Stegun give them
 pub fn erfc_poly(x: f32) -> f32 {
     let t = 1.0 / (1.0 + 0.3275911 * x);
     t * (0.254829592 + t * (-0.284496736 + t * (1.421413741 + t * (-1.453152027 + t * 1.061405429))))
@@ -312,7 +313,7 @@ pub fn beckmann_lambda(w: Vec3, ax: f32, ay: f32) -> f32 {
     }
     let a = w.z / t;
     let e = (-a * a).exp();
-    e * (0.28209479177387814 / a - 0.5 * erfc_poly(a))
+    e * (0.282_094_8 / a - 0.5 * erfc_poly(a)) // 1/(2√π)
 }
 
 /// Smith Λ of the model's distribution family (GTR-γ uses GGX's).

@@ -26,7 +26,8 @@ pub fn choose_lobes(s: &Lobes, view: &View) -> LobeChoice {
     let w_specular = luminance(s.cspec0.lerp(Vec3::ONE, view.fv));
     let w_clearcoat = s.clearcoat * mix(0.04, 1.0, view.fv);
     let total = w_diffuse + w_specular + w_clearcoat;
-    if !(total > 0.0) {
+    // Written so that a NaN total also falls back to the diffuse lobe.
+    if total.is_nan() || total <= 0.0 {
         return LobeChoice { diffuse: 1.0, specular: 0.0, clearcoat: 0.0 };
     }
     LobeChoice { diffuse: w_diffuse / total, specular: w_specular / total, clearcoat: w_clearcoat / total }
