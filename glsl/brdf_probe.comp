@@ -1,15 +1,18 @@
 #version 460
 // Evaluates the BRDF and the BRDF sampling pdf for a list of (material, l, v) records, so tests
-// can compare the GPU against the Rust reference.
+// can compare the GPU against the Rust reference; the model is the pipeline's specialization.
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 64) in;
+
+#define ENERGY_TABLE_SET 0
+#define ENERGY_TABLE_BINDING 2
 
 #include "brdf.glsl"
 #include "sampling.glsl"
 
 struct Record {
-    vec4 params[4];
+    vec4 params[4];  // the material, as Params::to_gpu lays it out
     vec4 l;  // shading frame
     vec4 v;
 };

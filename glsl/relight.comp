@@ -10,6 +10,10 @@
 
 layout(local_size_x = 16, local_size_y = 16) in;
 
+// The energy-compensation table of the model (a placeholder when compensation is off).
+#define ENERGY_TABLE_SET 0
+#define ENERGY_TABLE_BINDING 4
+
 #include "common.glsl"
 #include "material.glsl"
 #include "brdf.glsl"

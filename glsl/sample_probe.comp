@@ -6,6 +6,9 @@
 
 layout(local_size_x = 64) in;
 
+#define ENERGY_TABLE_SET 0
+#define ENERGY_TABLE_BINDING 3
+
 #include "brdf.glsl"
 #include "sampling.glsl"
 #include "sobol.glsl"
@@ -47,8 +50,9 @@ void main() {
         vec3 l = sample_cosine(azimuth(u.x), u.y);
         result = vec4(l, pdf_cosine(l));
     } else if (routine == ROUTINE_GGX) {
-        vec3 l = reflect(-v.v, sample_ggx_visible_normal(v.v_stretched, s.ax, s.ay, azimuth(u.x), u.y));
-        result = vec4(l, pdf_ggx_reflection(v, make_half_vector(s, l, v.v)));
+        // The model's specular sampler: GGX visible normals by default.
+        vec3 l = reflect(-v.v, sample_specular_normal(s, v, azimuth(u.x), u.y));
+        result = vec4(l, pdf_specular_reflection(v, make_half_vector(s, l, v.v)));
     } else if (routine == ROUTINE_GTR1) {
         vec3 l = reflect(-v.v, sample_gtr1_normal(s.cc_alpha2, s.cc_log2_alpha2, azimuth(u.x), u.y));
         result = vec4(l, pdf_gtr1_reflection(v, make_half_vector(s, l, v.v)));

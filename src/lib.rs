@@ -12,6 +12,7 @@ pub mod environment;
 pub mod error;
 pub mod gbuffer;
 pub mod gpu;
+pub mod lab;
 pub mod material;
 pub mod render;
 pub mod shading;

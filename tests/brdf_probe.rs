@@ -7,7 +7,8 @@ use common::random::Random;
 use glam::Vec3;
 use lookdev::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context};
 use lookdev::material::{Param, Params};
-use lookdev::shading::brdf::{disney_brdf, make_half_vector, make_lobes, make_view};
+use lookdev::shading::brdf::{disney_brdf, make_half_vector, make_lobes_with, make_view, Shading};
+use lookdev::shading::model::{Diffuse, Model};
 use lookdev::shading::sampling::{brdf_pdf, choose_lobes};
 
 /// One probe record, laid out as `Record` in brdf_probe.comp.
@@ -39,36 +40,85 @@ fn random_params(rng: &mut Random) -> Params {
 }
 
 fn probe(ctx: &Context, records: &[Record]) -> Vec<[f32; 4]> {
-    let pipeline = ComputePipeline::new(
+    probe_model(ctx, &Model::default(), records).0
+}
+
+/// Runs the probe specialized for `model`; also gives the shading the Rust reference needs.
+fn probe_model(ctx: &Context, model: &Model, records: &[Record]) -> (Vec<[f32; 4]>, Shading) {
+    let pipeline = ComputePipeline::specialized(
         ctx,
         &shaders::BRDF_PROBE,
-        &[&[BindingKind::StorageBuffer, BindingKind::StorageBuffer]],
+        &[&[BindingKind::StorageBuffer; 3]],
         0,
+        &model.specialization(),
     )
     .unwrap();
+    let (energy, shading) = common::gpu::model_shading(ctx, model);
     let input = Buffer::with_data(ctx, bytemuck::cast_slice(records)).unwrap();
     let output = Buffer::storage(ctx, (records.len() * 16) as u64).unwrap();
-    let set = pipeline.bind(0, &[Binding::Buffer(&input), Binding::Buffer(&output)]).unwrap();
+    let set = pipeline.bind(0, &[Binding::Buffer(&input), Binding::Buffer(&output), Binding::Buffer(&energy)]).unwrap();
     ctx.run(|cmd| {
         pipeline.dispatch(cmd, &[&set], &[], [(records.len() as u32).div_ceil(64), 1, 1]);
         Ok(())
     })
     .unwrap();
-    bytemuck::cast_slice(&output.read(ctx).unwrap()).to_vec()
+    (bytemuck::cast_slice(&output.read(ctx).unwrap()).to_vec(), shading)
 }
 
 fn relative_error(gpu: f32, cpu: f32) -> f32 {
     (gpu - cpu).abs() / cpu.abs()
 }
 
+/// Every model variant the probe checks: the default, each diffuse model, each D, G and F, and
+/// energy compensation with two distributions.
+fn models() -> Vec<Model> {
+    let mut out = vec![Model::default()];
+    for text in [
+        "diffuse=lambert",
+        "diffuse=frostbite",
+        "diffuse=oren-nayar",
+        "diffuse=oren-nayar-qualitative",
+        "diffuse=oren-nayar-fujii",
+        "diffuse=gotanda",
+        "diffuse=hammon",
+        "specular_d=beckmann",
+        "specular_d=gtr,gtr_gamma=1.5",
+        "specular_d=gtr,gtr_gamma=3",
+        "specular_g=smith-height-correlated",
+        "specular_g=burley2012",
+        "specular_d=beckmann,specular_g=smith-height-correlated",
+        "fresnel=dielectric",
+        "fresnel=conductor",
+        "energy_compensation=true",
+        "energy_compensation=true,specular_d=beckmann,specular_g=smith-height-correlated,fresnel=conductor",
+    ] {
+        let mut model = Model::default();
+        for part in text.split(',') {
+            model.set_from_text(part).unwrap();
+        }
+        out.push(model);
+    }
+    out
+}
+
 #[test]
 fn gpu_brdf_and_pdf_match_the_rust_reference() {
     let ctx = common::gpu::context();
+    for model in models() {
+        check_model(&ctx, &model);
+    }
+    common::gpu::finish(ctx);
+}
+
+fn check_model(ctx: &Context, model: &Model) {
     let mut rng = Random::new(7);
     let mut records = Vec::new();
     let mut params = Vec::new();
     for _ in 0..8192 {
-        let p = random_params(&mut rng);
+        let mut p = random_params(&mut rng);
+        if rng.next_u32() % 2 == 0 {
+            p.ior_edge = [rng.uniform(), rng.uniform(), rng.uniform()];
+        }
         // Mostly the upper hemisphere; some below it to check the zero branch and the pdf of
         // directions below the horizon.
         let mut l = rng.direction();
@@ -82,10 +132,17 @@ fn gpu_brdf_and_pdf_match_the_rust_reference() {
         records.push(Record { params: p.to_gpu(), l: l.extend(0.0).to_array(), v: v.extend(0.0).to_array() });
         params.push(p);
     }
-    let results = probe(&ctx, &records);
+    let (results, shading) = probe_model(ctx, model, &records);
+    // lavapipe's acos is good to about 1e-4 relative, and the full Oren–Nayar model needs the
+    // angles themselves; the energy table's bilinear lookup at grazing amplifies rounding of its
+    // √μ coordinate. Everything else is within the default model's tolerance.
+    // Near roughness 0 the compensation is a ratio of differences 1 − E of values E close to 1, so
+    // it is compared to an absolute 1e-5 as well.
+    let tolerance = if model.diffuse == Diffuse::OrenNayar || model.energy_compensation { 1e-3 } else { 1e-4 };
+    let absolute = if model.energy_compensation { 1e-5 } else { 0.0 };
     let (mut compared, mut worst) = (0, 0.0f32);
     for (i, (record, result)) in records.iter().zip(&results).enumerate() {
-        let lobes = make_lobes(&params[i]);
+        let lobes = make_lobes_with(&params[i], &shading);
         let l = Vec3::from_slice(&record.l[..3]);
         let v = Vec3::from_slice(&record.v[..3]);
         let view = make_view(&lobes, v);
@@ -93,20 +150,29 @@ fn gpu_brdf_and_pdf_match_the_rust_reference() {
         let f = disney_brdf(&lobes, &view, l, &hv);
         let pdf = if v.z > 0.0 { brdf_pdf(&choose_lobes(&lobes, &view), &view, l, &hv) } else { 0.0 };
         for (c, (&gpu, cpu)) in result.iter().zip([f.x, f.y, f.z, pdf]).enumerate() {
-            assert!(gpu.is_finite(), "record {i} channel {c}: GPU gave {gpu}");
+            assert!(gpu.is_finite(), "{model}: record {i} channel {c}: GPU gave {gpu}");
             if cpu > 1e-4 {
                 let err = relative_error(gpu, cpu);
-                worst = worst.max(err);
                 compared += 1;
-                assert!(err <= 1e-4, "record {i} channel {c}: GPU {gpu} vs CPU {cpu} ({:?}, l {l}, v {v})", params[i]);
+                if (gpu - cpu).abs() <= absolute {
+                    continue;
+                }
+                // At grazing, 1 − E(μ) of a nearly smooth surface is a small difference of table
+                // values, and the GPU's rounding of √μ shows in it.
+                let grazing = model.energy_compensation && l.z.min(v.z) < 1e-2;
+                worst = worst.max(err);
+                assert!(
+                    err <= if grazing { 1e-2 } else { tolerance },
+                    "{model}: record {i} channel {c}: GPU {gpu} vs CPU {cpu} ({:?}, l {l}, v {v})",
+                    params[i]
+                );
             } else {
-                assert!(gpu.abs() <= 2e-4, "record {i} channel {c}: GPU {gpu} vs CPU {cpu}");
+                assert!(gpu.abs() <= 2e-4, "{model}: record {i} channel {c}: GPU {gpu} vs CPU {cpu}");
             }
         }
     }
-    assert!(compared > 20_000, "only {compared} values were large enough to compare");
-    eprintln!("{compared} values compared, worst relative error {worst:e}");
-    common::gpu::finish(ctx);
+    assert!(compared > 20_000, "{model}: only {compared} values were large enough to compare");
+    eprintln!("{model}: {compared} values compared, worst relative error {worst:e}");
 }
 
 #[test]

@@ -47,6 +47,7 @@ impl Workspace {
     }
 }
 
+#[allow(clippy::type_complexity)]
 fn read_exr(path: &str) -> (usize, usize, Vec<(f32, f32, f32, f32)>) {
     let image = exr::prelude::read_first_rgba_layer_from_file(
         path,
@@ -232,5 +233,5 @@ fn a_missing_vulkan_driver_names_the_package() {
 }
 
 fn write_rgb_exr(path: &str, width: usize, height: usize, texel: impl Fn(usize, usize) -> (f32, f32, f32) + Sync) {
-    exr::prelude::write_rgb_file(path, width, height, |x, y| texel(x, y)).unwrap();
+    exr::prelude::write_rgb_file(path, width, height, texel).unwrap();
 }

@@ -145,7 +145,7 @@ fn the_map_is_oriented_and_rotated_as_specified() {
     for (rotation, expected_u) in [(0.0f64, 0.5), (90.0, 0.75), (-90.0, 0.25), (180.0, 0.0)] {
         // The spec's answer: the background shows direction −V = −Z, looked up at R_y(−r)·(−Z).
         let (s, c) = (-rotation).to_radians().sin_cos();
-        let d = [0.0 * c + -1.0 * s, 0.0, -0.0 * s + -1.0 * c];
+        let d = [-s, 0.0, -c]; // R_y(−r)·(0, 0, −1)
         let u = (0.5 + d[0].atan2(-d[2]) / (2.0 * PI)).rem_euclid(1.0);
         assert!((u - expected_u).abs() < 1e-9 || (u - expected_u).abs() > 1.0 - 1e-9, "rotation {rotation}: u {u}");
         // The quadrant seams sit at exactly these u, so render a hundredth of a turn further:

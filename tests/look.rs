@@ -61,7 +61,7 @@ fn unknown_keys_name_the_table_and_the_expected_keys() {
     );
     assert_eq!(
         error("# a look\ncolour = 1\n"),
-        "looks/shot.toml:2: unknown key 'colour' at the top level (expected environment, render, object)"
+        "looks/shot.toml:2: unknown key 'colour' at the top level (expected environment, render, model, object)"
     );
     assert_eq!(
         error("[[object]]\nid = 1\n[[object.layer]]\npreset = \"gold\"\nmaks = \"stripes\"\n"),
@@ -253,6 +253,7 @@ fn presets_round_trip_through_toml() {
         tags: vec![],
         params: Params { roughness: 0.1, ..Params::default() },
         set: vec![Param::Roughness],
+        ior: None,
     };
     assert_eq!(Preset::parse(&odd.to_toml(), Path::new("odd.toml")).unwrap(), odd);
 }
@@ -500,4 +501,58 @@ fn tables_of_the_wrong_shape_are_named() {
         error("[object]\nid = 1\n"),
         "looks/shot.toml:1: [object]: invalid type: map, expected a sequence (a list of tables is written [[name]])"
     );
+}
+
+// ---- The [model] table. ----
+
+#[test]
+fn model_table_parses_reads_back_and_names_bad_values() {
+    use lookdev::shading::model::{Diffuse, Fresnel, Model, SpecularD, SpecularG};
+    let text = "[model]\ndiffuse = \"oren-nayar\"\nspecular_d = \"gtr\"\ngtr_gamma = 1.5\n\
+                specular_g = \"smith-height-correlated\"\nfresnel = \"conductor\"\nenergy_compensation = true\n";
+    let look = Look::parse(text, Path::new(SHOT)).unwrap();
+    let model = look.model.unwrap();
+    assert_eq!(model.diffuse, Diffuse::OrenNayar);
+    assert_eq!(model.specular_d, SpecularD::Gtr);
+    assert_eq!(model.specular_g, SpecularG::SmithHeightCorrelated);
+    assert_eq!(model.fresnel, Fresnel::Conductor);
+    assert_eq!(model.gtr_gamma, 1.5);
+    assert!(model.energy_compensation);
+    // Written back, it reads back equal.
+    let again = Look::parse(&look.to_toml(), Path::new(SHOT)).unwrap();
+    assert_eq!(again.model, Some(model));
+    // No table: no model; an empty table: the default model.
+    assert_eq!(Look::parse("", Path::new(SHOT)).unwrap().model, None);
+    assert_eq!(Look::parse("[model]\n", Path::new(SHOT)).unwrap().model, Some(Model::default()));
+
+    assert_eq!(
+        error("[model]\n\ndiffuse = \"lambret\"\n"),
+        "looks/shot.toml:3: diffuse = 'lambret' is not a model (expected burley2012, lambert, frostbite, oren-nayar, \
+         oren-nayar-qualitative, oren-nayar-fujii, gotanda, hammon); did you mean 'lambert'?"
+    );
+    let message = error("[model]\nspecular = \"gtr\"\n");
+    assert!(message.starts_with("looks/shot.toml:2: unknown model key 'specular'"), "{message}");
+    assert_eq!(error("[model]\ngtr_gamma = 20\n"), "looks/shot.toml:2: gtr_gamma = 20 is out of range [0.5, 10]");
+    assert_eq!(
+        error("[model]\nenergy_compensation = 1\n"),
+        "looks/shot.toml:2: energy_compensation takes true or false"
+    );
+    assert_eq!(error("[model]\nfresnel = 2\n"), "looks/shot.toml:2: fresnel takes a name in quotes");
+}
+
+#[test]
+fn preset_complex_ior_must_match_its_base_color() {
+    let file = Path::new("presets/metal.toml");
+    let ok = "base_color = [0.9626, 0.8276, 0.4082]\nior_n = [0.14, 0.31, 1.38]\nior_k = [3.697, 2.34, 1.914]\n";
+    let preset = Preset::parse(ok, file).unwrap();
+    assert_eq!(preset.ior, Some(([0.14, 0.31, 1.38], [3.697, 2.34, 1.914])));
+    assert!(preset.params.ior_edge.iter().all(|&e| e > 0.0 && e <= 1.0));
+    assert_eq!(Preset::parse(&preset.to_toml(), file).unwrap(), preset);
+    let bad = |text: &str| Preset::parse(text, file).unwrap_err().to_string();
+    assert_eq!(bad("ior_n = [1, 1, 1]\n"), "presets/metal.toml:1: ior_n needs ior_k beside it");
+    assert_eq!(
+        bad("base_color = [0.5, 0.8276, 0.4082]\nior_n = [0.14, 0.31, 1.38]\nior_k = [3.697, 2.34, 1.914]\n"),
+        "presets/metal.toml:2: base_color[0] = 0.5 is not the F0 0.9626 of ior_n and ior_k (within 0.005)"
+    );
+    assert_eq!(bad("ior_n = [0, 1, 1]\nior_k = [0, 0, 0]\n"), "presets/metal.toml:1: ior_n[0] = 0 must be in (0, 100]");
 }

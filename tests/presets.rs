@@ -141,6 +141,17 @@ fn metal_base_colors_are_f0_of_the_cited_complex_ior() {
             assert!(preset.description.contains(&cited), "{name}: the description does not cite {cited}");
         }
     }
+    // The cited values are also the preset's ior_n and ior_k, which the conductor Fresnel model
+    // reads back through the material's edge parameter.
+    for (name, nk) in METALS {
+        let (n, k) = get(name).ior.unwrap_or_else(|| panic!("{name}: no ior_n and ior_k"));
+        let p = get(name).params;
+        for (c, (cn, ck)) in nk.iter().enumerate() {
+            assert_eq!((n[c], k[c]), (cn.parse::<f32>().unwrap(), ck.parse::<f32>().unwrap()), "{name} channel {c}");
+            let (n2, k2) = lookdev::shading::brdf::complex_ior(p.base_color[c], p.ior_edge[c]);
+            assert!((n2 - n[c]).abs() < 0.02 * n[c].max(1.0) && (k2 - k[c]).abs() < 0.02 * k[c].max(1.0), "{name}");
+        }
+    }
     let tabled: BTreeSet<&str> = METALS.iter().map(|(name, _)| *name).collect();
     for preset in all().into_iter().filter(|p| p.params.metallic == 1.0) {
         assert!(tabled.contains(preset.name.as_str()), "{}: a metal without cited (n, k) in METALS", preset.name);

@@ -12,7 +12,8 @@ use lookdev::environment::distribution::row_cos;
 use lookdev::environment::{self, Distribution, Environment, GpuEnvironment};
 use lookdev::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context};
 use lookdev::material::Params;
-use lookdev::shading::brdf::{make_half_vector, make_lobes, make_view};
+use lookdev::shading::brdf::{make_half_vector, make_lobes, make_lobes_with, make_view, Lobes, Shading};
+use lookdev::shading::model::Model;
 use lookdev::shading::{sampling, sobol};
 
 const COSINE: u32 = 0;
@@ -37,15 +38,40 @@ struct Setup {
 struct Probe {
     ctx: Context,
     pipeline: ComputePipeline,
+    energy: Buffer,
+    shading: Shading,
 }
 
 impl Probe {
     fn new() -> Probe {
-        let ctx = common::gpu::context();
-        let buffers = [BindingKind::StorageBuffer; 3];
-        let pipeline =
-            ComputePipeline::new(&ctx, &shaders::SAMPLE_PROBE, &[&buffers, &environment::gpu::SET_LAYOUT], 0).unwrap();
-        Probe { ctx, pipeline }
+        Probe::with_model(common::gpu::context(), &Model::default())
+    }
+
+    /// The probe specialized for a BRDF model, on `ctx`.
+    fn with_model(ctx: Context, model: &Model) -> Probe {
+        let buffers = [BindingKind::StorageBuffer; 4];
+        let pipeline = ComputePipeline::specialized(
+            &ctx,
+            &shaders::SAMPLE_PROBE,
+            &[&buffers, &environment::gpu::SET_LAYOUT],
+            0,
+            &model.specialization(),
+        )
+        .unwrap();
+        let (energy, shading) = common::gpu::model_shading(&ctx, model);
+        Probe { ctx, pipeline, energy, shading }
+    }
+
+    /// The Rust reference's per-pixel state for a material, under the probe's model.
+    fn lobes(&self, params: &Params) -> Lobes {
+        make_lobes_with(params, &self.shading)
+    }
+
+    /// Gives the context back, for the next model's probe.
+    fn into_context(self) -> Context {
+        drop(self.pipeline);
+        drop(self.energy);
+        self.ctx
     }
 
     /// Runs `routine` on `uniforms`, returning (direction or point, pdf) per sample.
@@ -82,7 +108,15 @@ impl Probe {
         let gpu_env = GpuEnvironment::upload(ctx, env, distribution).unwrap();
         let set0 = self
             .pipeline
-            .bind(0, &[Binding::Buffer(&setup), Binding::Buffer(&uniforms_buffer), Binding::Buffer(&output)])
+            .bind(
+                0,
+                &[
+                    Binding::Buffer(&setup),
+                    Binding::Buffer(&uniforms_buffer),
+                    Binding::Buffer(&output),
+                    Binding::Buffer(&self.energy),
+                ],
+            )
             .unwrap();
         let set1 = self.pipeline.bind(1, &gpu_env.bindings()).unwrap();
         ctx.run(|cmd| {
@@ -95,8 +129,7 @@ impl Probe {
     }
 
     fn finish(self) {
-        drop(self.pipeline);
-        common::gpu::finish(self.ctx);
+        common::gpu::finish(self.into_context());
     }
 }
 
@@ -231,6 +264,76 @@ fn brdf_samplers_match_their_pdfs() {
         check_routine(name, &samples, &pdf, &well_conditioned, &bins);
     }
     probe.finish();
+}
+
+/// The samplers each model adds (Beckmann and GTR-γ normals, and the lobe mixture with the
+/// energy-compensation lobe) against their pdfs, run on the GPU specialized for the model.
+#[test]
+fn model_samplers_match_their_pdfs() {
+    let env = Environment::uniform([1.0; 3], 8, 4);
+    let bins = SphereBins { theta: 24, phi: 48 };
+    let cases = [
+        ("beckmann rough", "specular_d=beckmann", GGX, material(0.8, 0.0, 1.0, 0.0, 1.0), view(50.0, 20.0)),
+        ("beckmann anisotropic", "specular_d=beckmann", GGX, material(0.55, 0.8, 1.0, 0.0, 1.0), view(40.0, 70.0)),
+        ("beckmann grazing", "specular_d=beckmann", GGX, material(0.6, 0.3, 1.0, 0.0, 1.0), view(80.0, 200.0)),
+        ("gtr gamma 1", "specular_d=gtr gtr_gamma=1", GGX, material(0.7, 0.0, 1.0, 0.0, 1.0), view(30.0, 0.0)),
+        ("gtr gamma 1.5", "specular_d=gtr gtr_gamma=1.5", GGX, material(0.6, 0.0, 1.0, 0.0, 1.0), view(45.0, 0.0)),
+        ("gtr gamma 3", "specular_d=gtr gtr_gamma=3", GGX, material(0.7, 0.5, 1.0, 0.0, 1.0), view(70.0, 100.0)),
+        (
+            "mixture beckmann height-correlated",
+            "specular_d=beckmann specular_g=smith-height-correlated",
+            BRDF,
+            material(0.5, 0.0, 0.0, 0.5, 0.5),
+            view(45.0, 10.0),
+        ),
+        (
+            "mixture gtr oren-nayar conductor",
+            "specular_d=gtr gtr_gamma=2.5 diffuse=oren-nayar fresnel=conductor",
+            BRDF,
+            material(0.6, 0.0, 0.3, 0.0, 1.0),
+            view(55.0, 40.0),
+        ),
+        (
+            "mixture energy compensation metal",
+            "energy_compensation=true",
+            BRDF,
+            material(0.8, 0.0, 1.0, 0.0, 1.0),
+            view(60.0, 30.0),
+        ),
+        (
+            "mixture energy compensation beckmann",
+            "energy_compensation=true specular_d=beckmann",
+            BRDF,
+            material(0.9, 0.2, 0.5, 0.0, 1.0),
+            view(75.0, 150.0),
+        ),
+    ];
+    let mut ctx = Some(common::gpu::context());
+    for (index, (name, text, routine, params, v)) in cases.iter().enumerate() {
+        let mut model = Model::default();
+        for part in text.split(' ') {
+            model.set_from_text(part).unwrap();
+        }
+        let probe = Probe::with_model(ctx.take().unwrap(), &model);
+        let samples = probe.run(*routine, params, *v, 0, &uniforms(SAMPLES, 500 + index as u32), &env);
+        let lobes = probe.lobes(params);
+        let view = make_view(&lobes, *v);
+        let choice = sampling::choose_lobes(&lobes, &view);
+        if *routine == BRDF && model.energy_compensation {
+            assert!(choice.diffuse > 0.0, "{name}: the compensation lobe must be sampled");
+        }
+        let pdf = |l: Vec3| -> f64 {
+            let hv = make_half_vector(&lobes, l, *v);
+            (match *routine {
+                GGX => sampling::pdf_specular_reflection(&view, &hv),
+                _ => sampling::brdf_pdf(&choice, &view, l, &hv),
+            }) as f64
+        };
+        let well_conditioned = |l: Vec3| (l + *v).length() > 1e-2;
+        check_routine(name, &samples, &pdf, &well_conditioned, &bins);
+        ctx = Some(probe.into_context());
+    }
+    common::gpu::finish(ctx.unwrap());
 }
 
 /// A synthetic environment with a small hot sun, a sky gradient and an entirely black lower

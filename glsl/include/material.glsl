@@ -1,4 +1,4 @@
-// The eleven Disney parameters and their GPU layout: four vec4s, as Params::to_gpu writes them.
+// The eleven Disney parameters (and the complex IOR's edge parameter) and their GPU layout: four vec4s, as Params::to_gpu writes them.
 #ifndef LOOKDEV_MATERIAL_GLSL
 #define LOOKDEV_MATERIAL_GLSL
 
@@ -14,6 +14,7 @@ struct Material {
     float sheen_tint;
     float clearcoat;
     float clearcoat_gloss;
+    vec3 ior_edge;    // where the complex IOR lies between its two dielectric ends (presets' ior_n, ior_k)
 };
 
 Material unpack_material(vec4 p0, vec4 p1, vec4 p2, vec4 p3) {
@@ -29,6 +30,7 @@ Material unpack_material(vec4 p0, vec4 p1, vec4 p2, vec4 p3) {
     m.sheen_tint = p2.z;
     m.clearcoat = p2.w;
     m.clearcoat_gloss = p3.x;
+    m.ior_edge = p3.yzw;
     return m;
 }
 

@@ -12,13 +12,17 @@
 // Probabilities of picking each lobe for one-sample MIS; they sum to 1.
 struct LobeChoice {
     float diffuse;    // diffuse, subsurface and sheen: cosine sampling
-    float specular;   // GGX visible normals
+    float specular;   // GGX visible normals, or the model's distribution of normals
     float clearcoat;  // GTR1 half vectors
 };
 
 // Picks lobes in proportion to an estimate of their reflectance at this view angle.
 LobeChoice choose_lobes(Lobes s, View view) {
     float w_diffuse = (1.0 - s.metallic) * (luminance(s.base_color) + 0.25 * luminance(s.sheen_color));
+    if (MODEL_ENERGY_COMPENSATION != 0u) {
+        // The multiple-scattering lobe is nearly cosine-shaped; its albedo is F_ms·(1 − E(μv)).
+        w_diffuse += luminance(s.ms_fresnel) * view.ms_v;
+    }
     float w_specular = luminance(mix(s.cspec0, vec3(1.0), view.fv));
     float w_clearcoat = s.clearcoat * mix(0.04, 1.0, view.fv);
     float total = w_diffuse + w_specular + w_clearcoat;
@@ -55,7 +59,61 @@ vec3 sample_ggx_visible_normal(vec3 v_stretched, float ax, float ay, vec2 azimut
 
 // pdf of l = reflect(−v, h) for visible-normal sampling: G1(v)·D(h)/(4·N·v) = g(v)·D(h)/2.
 float pdf_ggx_reflection(View view, HalfVector hv) {
-    return hv.h.z > 0.0 ? 0.5 * view.g_spec * hv.d_spec : 0.0;
+    return hv.h.z > 0.0 ? 0.5 * view.g_vndf * hv.d_spec : 0.0;
+}
+
+// A Beckmann normal, from the distribution of normals D(h)·cosθh: Gaussian slopes, stretched.
+vec3 sample_beckmann_normal(float ax, float ay, vec2 azimuth, float u) {
+    float r = sqrt(-log(1.0 - u));
+    return normalize(vec3(ax * r * azimuth.x, ay * r * azimuth.y, 1.0));
+}
+
+// A GTR-γ normal from D(h)·cosθh (Burley 2012, appendix B): with s = 1 + (α²−1)·cos²θh,
+// s^(1−γ) = (1−u)·α^(2(1−γ)) + u; γ = 1 is GTR1's logarithmic form. Written with expm1 and log1p
+// so that it stays accurate as α → 1, where 1 − s and 1 − α² both vanish.
+vec3 sample_gtr_normal(float alpha2, float gamma, vec2 azimuth, float u) {
+    float cos2;
+    if (alpha2 >= 1.0) {
+        cos2 = 1.0 - u;
+    } else {
+        float log_alpha2 = log_accurate(alpha2);
+        float one_minus_s;
+        if (abs(gamma - 1.0) < 1e-4) {
+            one_minus_s = -expm1_accurate(log_alpha2 * (1.0 - u));
+        } else {
+            float e = 1.0 - gamma;
+            one_minus_s = -expm1_accurate(log1p_accurate((1.0 - u) * expm1_accurate(e * log_alpha2)) / e);
+        }
+        cos2 = one_minus_s / (1.0 - alpha2);
+    }
+    cos2 = clamp(cos2, 0.0, 1.0);
+    return vec3(sqrt(1.0 - cos2) * azimuth, sqrt(cos2));
+}
+
+// pdf of l = reflect(−v, h) when h is drawn from D(h)·cosθh: D(h)·|N·h|/(4·|v·h|), counting both
+// half vectors ±normalize(l + v), as for GTR1 below.
+float pdf_normal_reflection(float d, View view, vec3 h) {
+    float vh = abs(dot(view.v, h));
+    return vh > 0.0 ? d * abs(h.z) / (4.0 * vh) : 0.0;
+}
+
+// pdf of the specular sampler of the model.
+float pdf_specular_reflection(View view, HalfVector hv) {
+    if (MODEL_SPECULAR_D == SPECULAR_D_GTR2) {
+        return pdf_ggx_reflection(view, hv);
+    }
+    return pdf_normal_reflection(hv.d_spec, view, hv.h);
+}
+
+// A specular half vector of the model: GGX visible normals, or the distribution of normals.
+vec3 sample_specular_normal(Lobes s, View view, vec2 azimuth, float u) {
+    if (MODEL_SPECULAR_D == SPECULAR_D_BECKMANN) {
+        return sample_beckmann_normal(s.ax, s.ay, azimuth, u);
+    }
+    if (MODEL_SPECULAR_D == SPECULAR_D_GTR) {
+        return sample_gtr_normal(s.ax * s.ax, MODEL_GTR_GAMMA, azimuth, u);
+    }
+    return sample_ggx_visible_normal(view.v_stretched, s.ax, s.ay, azimuth, u);
 }
 
 // A GTR1 half vector (Burley 2012, appendix B): cos²θh = (1 − α^(2(1−u)))/(1 − α²).
@@ -78,7 +136,7 @@ float pdf_gtr1_reflection(View view, HalfVector hv) {
 float brdf_pdf(LobeChoice c, View view, vec3 l, HalfVector hv) {
     float pdf = c.diffuse * pdf_cosine(l);
     if (c.specular > 0.0) {
-        pdf += c.specular * pdf_ggx_reflection(view, hv);
+        pdf += c.specular * pdf_specular_reflection(view, hv);
     }
     if (c.clearcoat > 0.0) {
         pdf += c.clearcoat * pdf_gtr1_reflection(view, hv);
@@ -105,7 +163,7 @@ vec3 sample_brdf(Lobes s, LobeChoice c, View view, vec2 u) {
     if (lobe == 0u) {
         return sample_cosine(phi, u.y);
     }
-    vec3 h = lobe == 1u ? sample_ggx_visible_normal(view.v_stretched, s.ax, s.ay, phi, u.y)
+    vec3 h = lobe == 1u ? sample_specular_normal(s, view, phi, u.y)
                         : sample_gtr1_normal(s.cc_alpha2, s.cc_log2_alpha2, phi, u.y);
     return reflect(-view.v, h);
 }

@@ -50,6 +50,7 @@ impl Import {
                     tags: vec!["imported".into(), "gltf".into()],
                     params: mapped.params,
                     set: Param::ALL.to_vec(),
+                    ior: None,
                 };
                 ImportedMaterial { used, mapped, preset }
             })
@@ -97,6 +98,7 @@ impl Import {
             file: Some(look_file.to_path_buf()),
             environment: EnvironmentSettings::default(),
             render: RenderSettings::default(),
+            model: None,
             objects: vec![ObjectStack { id: None, layers }],
         }
     }
@@ -192,6 +194,7 @@ mod tests {
                 tags: Vec::new(),
                 params,
                 set: Param::ALL.to_vec(),
+                ior: None,
             },
         }
     }

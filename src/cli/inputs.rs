@@ -37,7 +37,7 @@ impl LightingArgs {
     }
 }
 
-/// Samples per pixel and the sequence's seed.
+/// Samples per pixel, the sequence's seed, and the BRDF model they estimate.
 #[derive(Args, Debug, Default)]
 pub struct SamplingArgs {
     /// Samples per pixel (each one environment and one BRDF sample).
@@ -45,6 +45,10 @@ pub struct SamplingArgs {
     pub spp: Option<u32>,
     #[arg(long, value_name = "N")]
     pub seed: Option<u32>,
+    /// Choose a BRDF model variant over the look's [model], e.g. --model diffuse=oren-nayar
+    /// (keys: diffuse, specular_d, specular_g, fresnel, gtr_gamma, energy_compensation).
+    #[arg(long = "model", value_name = "KEY=VALUE")]
+    pub model: Vec<String>,
 }
 
 /// How linear radiance becomes PNG pixels.
@@ -73,6 +77,7 @@ pub fn overrides(lighting: &LightingArgs, sampling: &SamplingArgs, display: &Dis
         seed: sampling.seed,
         exposure: display.exposure,
         tonemap: display.tonemap,
+        model: sampling.model.clone(),
     }
 }
 

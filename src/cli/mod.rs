@@ -1,7 +1,9 @@
-//! The command line: `lookdev render | gbuffer | bake | import | presets | wedge | turntable | view | lint | bench | devices`.
+//! The command line: `lookdev render | gbuffer | bake | import | presets | wedge | turntable | view | lint | brdf |
+//! bench | devices`.
 
 mod bake;
 mod bench;
+mod brdf;
 mod gbuffer;
 mod import;
 mod inputs;
@@ -47,6 +49,8 @@ pub enum Command {
     View(view::ViewArgs),
     /// Check a look's materials for implausible values.
     Lint(lint::LintArgs),
+    /// BRDF Explorer-style plots of materials under BRDF models: slice, albedo, polar, furnace.
+    Brdf(brdf::BrdfArgs),
     /// Measure relighting throughput on the built-in scene.
     Bench(bench::BenchArgs),
     /// List the Vulkan devices lookdev can use, best first.
@@ -84,6 +88,7 @@ pub fn run(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<()> {
         Command::Turntable(args) => turntable::run(args),
         Command::View(args) => view::run(args),
         Command::Lint(args) => lint::run(args),
+        Command::Brdf(args) => brdf::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Devices => list_devices(),
     }

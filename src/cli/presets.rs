@@ -147,6 +147,10 @@ fn show(name: &str) -> Result<()> {
         let mark = if preset.set.contains(&param) { "" } else { "  # default" };
         println!("{param} = {}{mark}", preset.params.get(param));
     }
+    if let Some((n, k)) = preset.ior {
+        println!("ior_n = {n:?}");
+        println!("ior_k = {k:?}");
+    }
     Ok(())
 }
 
@@ -171,7 +175,9 @@ fn save(args: SaveArgs) -> Result<()> {
     };
     let mut set: Vec<Param> = Param::ALL.into_iter().filter(|p| set.contains(p)).collect();
     set.dedup();
-    let preset = Preset { name: args.name, description: args.description, tags: args.tags, params, set };
+    // The eleven parameters only: a look's complex IOR belongs to the preset it came from.
+    let params = Params { ior_edge: [0.0; 3], ..params };
+    let preset = Preset { name: args.name, description: args.description, tags: args.tags, params, set, ior: None };
     let path = library::save_preset(&dir, &preset, args.force)?;
     println!("{}", path.display());
     Ok(())
@@ -217,7 +223,7 @@ fn sheet(args: SheetArgs) -> Result<()> {
     if args.lighting.env.is_some() {
         base.environment = Default::default();
     }
-    let sampling = SamplingArgs { spp: Some(args.spp), seed: None };
+    let sampling = SamplingArgs { spp: Some(args.spp), ..SamplingArgs::default() };
     let settings = Settings::resolve(&base, &inputs::overrides(&args.lighting, &sampling, &args.display))?;
     let environment = match &settings.environment {
         Some(path) => environment::load::load(path, &args.lighting.load_options())?,

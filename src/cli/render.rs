@@ -56,7 +56,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let device_name = ctx.info().name.clone();
     let settings = &scene.settings;
     let stats = {
-        let mut renderer = Renderer::new(&ctx, &scene.gbuffer, &scene.environment)?;
+        let mut renderer = Renderer::with_model(&ctx, &scene.gbuffer, &scene.environment, &settings.model)?;
         renderer.set_stacks(&scene.stacks)?;
         renderer.set_lighting(settings.lighting);
         renderer.set_seed(settings.seed);

@@ -97,7 +97,7 @@ pub fn run(args: WedgeArgs) -> Result<()> {
         None if args.lighting.env.is_some() => Look { environment: Default::default(), ..default_look() },
         None => default_look(),
     };
-    let sampling = SamplingArgs { spp: Some(args.spp), seed: None };
+    let sampling = SamplingArgs { spp: Some(args.spp), ..SamplingArgs::default() };
     let settings = Settings::resolve(&look, &inputs::overrides(&args.lighting, &sampling, &args.display))?;
     let environment = match &settings.environment {
         Some(path) => environment::load::load(path, &args.lighting.load_options())?,

@@ -75,6 +75,10 @@ impl Table {
         self.cdf.len() - 1
     }
 
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
     /// The last interval r with `cdf[r] ≤ u`, as `env_search` finds it.
     pub fn search(&self, u: f32) -> usize {
         let k = bucket(u, self.len() as u32) as usize;

@@ -43,6 +43,18 @@ pub struct ComputePipeline {
 
 impl ComputePipeline {
     pub fn new(ctx: &Context, kernel: &Kernel, sets: &[&[BindingKind]], push_size: u32) -> Result<ComputePipeline> {
+        ComputePipeline::specialized(ctx, kernel, sets, push_size, &[])
+    }
+
+    /// A pipeline whose specialization constants 0, 1, … take the 32-bit values `constants`
+    /// (model.glsl's model choices); the rest keep their defaults.
+    pub fn specialized(
+        ctx: &Context,
+        kernel: &Kernel,
+        sets: &[&[BindingKind]],
+        push_size: u32,
+        constants: &[u32],
+    ) -> Result<ComputePipeline> {
         let device = &ctx.device;
         let code = ash::util::read_spv(&mut std::io::Cursor::new(kernel.spirv))
             .map_err(|e| Error::gpu(format!("kernel {}: bad SPIR-V ({e})", kernel.name)))?;
@@ -70,10 +82,18 @@ impl ComputePipeline {
             layout_info = layout_info.push_constant_ranges(&ranges);
         }
         let layout = unsafe { device.create_pipeline_layout(&layout_info, None) }?;
-        let stage = vk::PipelineShaderStageCreateInfo::default()
+        let entries: Vec<vk::SpecializationMapEntry> = (0..constants.len() as u32)
+            .map(|i| vk::SpecializationMapEntry::default().constant_id(i).offset(4 * i).size(4))
+            .collect();
+        let specialization =
+            vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(constants));
+        let mut stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module)
             .name(c"main");
+        if !constants.is_empty() {
+            stage = stage.specialization_info(&specialization);
+        }
         let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout);
         let pipeline = unsafe { device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
         unsafe { device.destroy_shader_module(module, None) };

@@ -25,8 +25,11 @@ pub const BRDF_PROBE: Kernel = kernel!("brdf_probe");
 /// Sampling routines and the Sobol sequence, for the chi-square and sequence tests.
 pub const SAMPLE_PROBE: Kernel = kernel!("sample_probe");
 
+/// The energy-compensation table of a BRDF model.
+pub const ENERGY_TABLE: Kernel = kernel!("energy_table");
+
 /// Every kernel, with the GLSL file it is compiled from (`glsl/<name>.comp`).
-pub const ALL: [&Kernel; 5] = [&RESOLVE, &RELIGHT, &FINALIZE, &BRDF_PROBE, &SAMPLE_PROBE];
+pub const ALL: [&Kernel; 6] = [&RESOLVE, &RELIGHT, &FINALIZE, &BRDF_PROBE, &SAMPLE_PROBE, &ENERGY_TABLE];
 
 /// One graphics shader stage's SPIR-V, compiled from `glsl/<file>`.
 pub struct Stage {

@@ -8,6 +8,9 @@
 //! intensity = 1.0        # finite, >= 0
 //! background = true
 //!
+//! [model]                # optional; the BRDF model (README: BRDF models); --model overrides
+//! diffuse = "burley2012" # and specular_d, specular_g, fresnel, gtr_gamma, energy_compensation
+//!
 //! [render]               # optional; command-line flags override
 //! spp = 256              # >= 1
 //! seed = 0               # any u32
@@ -43,6 +46,7 @@ use super::library::Library;
 use super::params::{Param, Params, Value};
 use super::toml_input::{self as input, Field, Source};
 use crate::render::tonemap::Tonemap;
+use crate::shading::model::{Model, ModelValue};
 
 /// What to render: environment, render settings and the layer stacks.
 #[derive(Clone, Debug, PartialEq)]
@@ -53,6 +57,8 @@ pub struct Look {
     pub environment: EnvironmentSettings,
     /// From `[render]`.
     pub render: RenderSettings,
+    /// From `[model]`: the BRDF model, `None` when the look has no such table (the default).
+    pub model: Option<Model>,
     /// From `[[object]]`, in file order.
     pub objects: Vec<ObjectStack>,
 }
@@ -161,6 +167,7 @@ impl Look {
             file: None,
             environment: EnvironmentSettings::default(),
             render: RenderSettings::default(),
+            model: None,
             objects: Vec::new(),
         };
         look.ensure_default_stack();
@@ -215,6 +222,10 @@ impl Look {
         let mut lines = Vec::new();
         self.write_environment(&mut lines);
         self.write_render(&mut lines);
+        if let Some(model) = &self.model {
+            let body = model.entries().into_iter().map(|(k, v)| format!("{k} = {v}")).collect();
+            push_section(&mut lines, "[model]", body);
+        }
         for object in &self.objects {
             object.write(&mut lines);
         }
@@ -316,6 +327,8 @@ fn push_section(lines: &mut Vec<String>, header: &str, body: Vec<String>) {
 struct LookFile {
     environment: Option<EnvironmentFile>,
     render: Option<RenderFile>,
+    /// Keys are checked by `Model::set`, which names the values each takes.
+    model: Option<BTreeMap<Field<String>, Field>>,
     #[serde(default)]
     object: Vec<Field<ObjectFile>>,
 }
@@ -366,6 +379,7 @@ fn parse_with(src: Source, library: &Library) -> crate::Result<Look> {
         file: None,
         environment: environment(&src, raw.environment, folder)?,
         render: render(&src, raw.render)?,
+        model: model(&src, raw.model.as_ref())?,
         objects: objects(&src, &raw.object, library)?,
     };
     warn_about_bottom_layers(&src, &look);
@@ -394,6 +408,30 @@ fn render(src: &Source, raw: Option<RenderFile>) -> crate::Result<RenderSettings
         exposure: src.read("exposure", &raw.exposure, input::number)?,
         tonemap: src.read("tonemap", &raw.tonemap, tonemap)?,
     })
+}
+
+fn model(src: &Source, raw: Option<&BTreeMap<Field<String>, Field>>) -> crate::Result<Option<Model>> {
+    let Some(raw) = raw else {
+        return Ok(None);
+    };
+    let mut model = Model::default();
+    for (key, value) in raw {
+        let parsed = match value.get_ref() {
+            toml::Value::String(t) => ModelValue::Text(t),
+            toml::Value::Float(x) => ModelValue::Number(*x),
+            toml::Value::Integer(i) => ModelValue::Number(*i as f64),
+            toml::Value::Boolean(b) => ModelValue::Bool(*b),
+            other => {
+                return Err(
+                    src.error(value.span(), format!("{}: a {} is not a model value", key.get_ref(), other.type_str()))
+                )
+            }
+        };
+        let span =
+            if crate::shading::model::KEYS.contains(&key.get_ref().as_str()) { value.span() } else { key.span() };
+        model.set(key.get_ref(), parsed).map_err(|problem| src.error(span, problem))?;
+    }
+    Ok(Some(model))
 }
 
 /// Converts the `[[object]]` tables, checking that ids are unique and that there is at most one

@@ -136,6 +136,11 @@ pub struct Params {
     pub sheen_tint: f32,
     pub clearcoat: f32,
     pub clearcoat_gloss: f32,
+    /// Not one of the eleven: where the complex IOR of a measured metal (its preset's `ior_n`
+    /// and `ior_k`) lies between the two dielectric IORs of the same F0, per channel, so that
+    /// `base_color` (its F0) and this give (n, k) back. 0 for a dielectric. Only the
+    /// `conductor` Fresnel model reads it; it blends between layers like every parameter.
+    pub ior_edge: [f32; 3],
 }
 
 impl Default for Params {
@@ -152,6 +157,7 @@ impl Default for Params {
             sheen_tint: 0.5,
             clearcoat: 0.0,
             clearcoat_gloss: 1.0,
+            ior_edge: [0.0; 3],
         }
     }
 }
@@ -183,7 +189,7 @@ impl Params {
 
     /// The GPU layout, mirrored by `glsl/include/material.glsl`:
     /// `[base_color.rgb, metallic] [subsurface, specular, specular_tint, roughness]
-    ///  [anisotropic, sheen, sheen_tint, clearcoat] [clearcoat_gloss, 0, 0, 0]`.
+    ///  [anisotropic, sheen, sheen_tint, clearcoat] [clearcoat_gloss, ior_edge.rgb]`.
     pub fn to_gpu(&self) -> [f32; GPU_FLOATS] {
         let [r, g, b] = self.base_color;
         [
@@ -200,9 +206,9 @@ impl Params {
             self.sheen_tint,
             self.clearcoat,
             self.clearcoat_gloss,
-            0.0,
-            0.0,
-            0.0,
+            self.ior_edge[0],
+            self.ior_edge[1],
+            self.ior_edge[2],
         ]
     }
 
@@ -219,6 +225,7 @@ impl Params {
             sheen_tint: v[10],
             clearcoat: v[11],
             clearcoat_gloss: v[12],
+            ior_edge: [v[13], v[14], v[15]],
         }
     }
 
@@ -279,9 +286,12 @@ mod tests {
         for p in Param::ALL {
             assert_eq!(Param::from_name(p.name()), Some(p));
         }
-        let mut params = Params::default();
-        params.base_color = [0.1, 0.2, 0.3];
-        params.clearcoat_gloss = 0.7;
+        let params = Params {
+            base_color: [0.1, 0.2, 0.3],
+            clearcoat_gloss: 0.7,
+            ior_edge: [0.2, 0.4, 0.6],
+            ..Params::default()
+        };
         assert_eq!(Params::from_gpu(&params.to_gpu()), params);
     }
 
@@ -302,9 +312,7 @@ mod tests {
     #[test]
     fn mix_is_per_parameter() {
         let a = Params::default();
-        let mut b = Params::default();
-        b.roughness = 0.1;
-        b.base_color = [1.0, 0.0, 0.0];
+        let b = Params { roughness: 0.1, base_color: [1.0, 0.0, 0.0], ..Params::default() };
         let m = a.mix(&b, 0.5);
         assert!((m.roughness - 0.3).abs() < 1e-6);
         assert!((m.base_color[0] - 0.9).abs() < 1e-6 && (m.base_color[1] - 0.4).abs() < 1e-6);

@@ -12,7 +12,9 @@
 //! ```
 //!
 //! Any of the eleven parameters may appear at the top level; those left out take the defaults
-//! of [`Params::default`]. Unknown keys, wrong types, NaN/inf and out-of-range values are
+//! of [`Params::default`]. A metal may also give its complex IOR per channel, `ior_n = [r, g, b]`
+//! and `ior_k = [r, g, b]`, for the `conductor` Fresnel model; its `base_color` must then be their
+//! F0 = ((n−1)² + k²)/((n+1)² + k²), within 0.005. Unknown keys, wrong types, NaN/inf and out-of-range values are
 //! errors of the form `FILE:LINE: problem`.
 
 use std::path::Path;
@@ -33,7 +35,12 @@ pub struct Preset {
     pub params: Params,
     /// Which parameters the file set explicitly, in [`Param::ALL`] order.
     pub set: Vec<Param>,
+    /// `ior_n` and `ior_k`, per channel, when the file gives them.
+    pub ior: Option<([f32; 3], [f32; 3])>,
 }
+
+/// How far `base_color` may be from the F0 of `ior_n` and `ior_k`.
+pub const IOR_F0_TOLERANCE: f32 = 0.005;
 
 /// The file as written. Every value is spanned so that errors can name its line.
 #[derive(Deserialize)]
@@ -53,6 +60,8 @@ struct PresetFile {
     sheen_tint: Option<Field>,
     clearcoat: Option<Field>,
     clearcoat_gloss: Option<Field>,
+    ior_n: Option<Field>,
+    ior_k: Option<Field>,
 }
 
 impl PresetFile {
@@ -86,12 +95,19 @@ impl Preset {
             tags: src.read("tags", &raw.tags, input::text_list)?.unwrap_or_default(),
             params: Params::default(),
             set: Vec::new(),
+            ior: None,
         };
         for (param, field) in raw.params() {
             if let Some(field) = field {
                 input::set_param(&mut preset.params, param, field.get_ref())
                     .map_err(|problem| src.error(field.span(), problem))?;
                 preset.set.push(param);
+            }
+        }
+        preset.ior = complex_ior(&src, &raw, &preset)?;
+        if let Some((n, k)) = preset.ior {
+            for c in 0..3 {
+                preset.params.ior_edge[c] = crate::shading::brdf::ior_edge(n[c], k[c]);
             }
         }
         Ok(preset)
@@ -114,7 +130,42 @@ impl Preset {
         for param in Param::ALL.into_iter().filter(|p| self.set.contains(p)) {
             lines.push(format!("{param} = {}", input::value(self.params.get(param))));
         }
+        if let Some((n, k)) = self.ior {
+            lines.push(format!("ior_n = {}", input::value(super::params::Value::Color(n))));
+            lines.push(format!("ior_k = {}", input::value(super::params::Value::Color(k))));
+        }
         lines.push(String::new());
         lines.join("\n")
     }
+}
+
+/// `ior_n` and `ior_k`: both or neither, n > 0 and k >= 0, and a `base_color` that is their F0.
+fn complex_ior(src: &Source, raw: &PresetFile, preset: &Preset) -> crate::Result<Option<([f32; 3], [f32; 3])>> {
+    let (n_field, k_field) = match (&raw.ior_n, &raw.ior_k) {
+        (None, None) => return Ok(None),
+        (Some(n), Some(k)) => (n, k),
+        (Some(n), None) => return Err(src.error(n.span(), "ior_n needs ior_k beside it")),
+        (None, Some(k)) => return Err(src.error(k.span(), "ior_k needs ior_n beside it")),
+    };
+    let n = input::color("ior_n", n_field.get_ref()).map_err(|p| src.error(n_field.span(), p))?;
+    let k = input::color("ior_k", k_field.get_ref()).map_err(|p| src.error(k_field.span(), p))?;
+    for c in 0..3 {
+        if !(n[c] > 0.0 && n[c] <= 100.0) {
+            return Err(src.error(n_field.span(), format!("ior_n[{c}] = {} must be in (0, 100]", n[c])));
+        }
+        if !(k[c] >= 0.0 && k[c] <= 100.0) {
+            return Err(src.error(k_field.span(), format!("ior_k[{c}] = {} must be in [0, 100]", k[c])));
+        }
+        let f0 = crate::shading::brdf::normal_reflectance(n[c] as f64, k[c] as f64) as f32;
+        let base = preset.params.base_color[c];
+        if (base - f0).abs() > IOR_F0_TOLERANCE {
+            return Err(src.error(
+                n_field.span(),
+                format!(
+                    "base_color[{c}] = {base} is not the F0 {f0:.4} of ior_n and ior_k (within {IOR_F0_TOLERANCE})"
+                ),
+            ));
+        }
+    }
+    Ok(Some((n, k)))
 }

@@ -295,7 +295,7 @@ pub(crate) fn set_param(params: &mut Params, param: Param, value: &toml::Value) 
     params.set(param, value)
 }
 
-fn color(key: &str, value: &toml::Value) -> Result<[f32; 3], String> {
+pub(crate) fn color(key: &str, value: &toml::Value) -> Result<[f32; 3], String> {
     match value {
         toml::Value::Array(items) if items.len() == 3 => {
             let mut rgb = [0.0; 3];

@@ -45,6 +45,7 @@ impl<'a> Batch<'a> {
         let masks: Vec<String> = self.gbuffer.masks.keys().cloned().collect();
         let stacks = PackedStacks::pack(look, covered_object_ids(self.gbuffer), &masks, self.gbuffer_name)?;
         self.renderer.set_stacks(&stacks)?;
+        self.renderer.set_model(&settings.model)?;
         self.renderer.set_lighting(settings.lighting);
         self.renderer.set_seed(settings.seed);
         progressive::accumulate(&mut self.renderer, settings.spp, progress)?;

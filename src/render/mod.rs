@@ -1,6 +1,7 @@
 //! Rendering: parameter resolve, progressive relighting, accumulation and display transforms.
 
 pub mod batch;
+pub mod energy;
 pub mod output;
 pub mod progressive;
 pub mod renderer;

@@ -7,8 +7,12 @@ use crate::gpu::pipeline::group_count;
 use crate::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, GpuTimer, Image};
 use crate::material::stack::PackedStacks;
 use crate::render::tonemap::Tonemap;
+use crate::shading::brdf::Shading;
+use crate::shading::energy::EnergyTable;
+use crate::shading::model::Model;
 use crate::Result;
 use ash::vk;
+use std::sync::Arc;
 
 /// Workgroup size of the 2D kernels (`local_size_x`, `local_size_y` in glsl/*.comp).
 const LOCAL_SIZE_X: u32 = 16;
@@ -74,11 +78,14 @@ pub struct Renderer {
     resolve: ComputePipeline,
     relight: ComputePipeline,
     finalize: ComputePipeline,
+    /// The BRDF model the relight pipeline is specialized for, with its energy table.
+    shading: Shading,
     // Held so the GPU resources that descriptor sets point at stay alive.
-    _surface: Image,
+    _energy: Buffer,
     resolved: Image,
-    _accumulation: Image,
-    _background: Image,
+    background: Image,
+    accumulation: Image,
+    surface: Image,
     radiance: Image,
     display: Image,
     object_ids: Vec<u32>,
@@ -101,18 +108,41 @@ fn float_image(ctx: &Context, width: u32, height: u32, layers: u32, data: &[[f32
     Ok(image)
 }
 
+/// The relight pipeline for a model, and the energy table it reads (a placeholder unless the
+/// model compensates energy; the table itself is built on the GPU).
+fn relight_pipeline(ctx: &Context, model: &Model) -> Result<(ComputePipeline, Shading, Buffer)> {
+    let image = BindingKind::StorageImage;
+    let buffer = BindingKind::StorageBuffer;
+    let relight = ComputePipeline::specialized(
+        ctx,
+        &shaders::RELIGHT,
+        &[&[image, image, image, image, buffer], &environment::gpu::SET_LAYOUT],
+        std::mem::size_of::<RelightPush>() as u32,
+        &model.specialization(),
+    )?;
+    let (table, energy) = if model.energy_compensation {
+        let table = crate::render::energy::build(ctx, model)?;
+        (table.clone(), Some(Arc::new(table)))
+    } else {
+        (EnergyTable::placeholder(), None)
+    };
+    let energy_buffer = Buffer::with_data(ctx, bytemuck::cast_slice(&table.values))?;
+    Ok((relight, Shading::new(*model, energy), energy_buffer))
+}
+
 impl Renderer {
+    /// A renderer of the default (Disney 2012) model.
     pub fn new(ctx: &Context, gbuffer: &GBuffer, environment: &Environment) -> Result<Renderer> {
+        Renderer::with_model(ctx, gbuffer, environment, &Model::default())
+    }
+
+    /// A renderer of a BRDF model (README: BRDF models).
+    pub fn with_model(ctx: &Context, gbuffer: &GBuffer, environment: &Environment, model: &Model) -> Result<Renderer> {
         let (width, height) = (gbuffer.width, gbuffer.height);
         let image = BindingKind::StorageImage;
         let buffer = BindingKind::StorageBuffer;
         let resolve = ComputePipeline::new(ctx, &shaders::RESOLVE, &[&[image, image, buffer, buffer, image]], 0)?;
-        let relight = ComputePipeline::new(
-            ctx,
-            &shaders::RELIGHT,
-            &[&[image, image, image, image], &environment::gpu::SET_LAYOUT],
-            std::mem::size_of::<RelightPush>() as u32,
-        )?;
+        let (relight, shading, energy) = relight_pipeline(ctx, model)?;
         let finalize =
             ComputePipeline::new(ctx, &shaders::FINALIZE, &[&[image; 5]], std::mem::size_of::<FinalizePush>() as u32)?;
 
@@ -139,6 +169,7 @@ impl Renderer {
                 Binding::Image(&resolved),
                 Binding::Image(&accumulation),
                 Binding::Image(&background),
+                Binding::Buffer(&energy),
             ],
         )?;
         let finalize_set = finalize.bind(
@@ -158,10 +189,12 @@ impl Renderer {
             resolve,
             relight,
             finalize,
-            _surface: surface,
+            shading,
+            _energy: energy,
             resolved,
-            _accumulation: accumulation,
-            _background: background,
+            accumulation,
+            background,
+            surface,
             radiance,
             display,
             object_ids: gbuffer.object_id.clone(),
@@ -184,6 +217,38 @@ impl Renderer {
         let gpu_environment = GpuEnvironment::upload(&self.ctx, environment, &distribution)?;
         self.environment_set = self.relight.bind(1, &gpu_environment.bindings())?;
         self._environment = gpu_environment;
+        self.restart();
+        Ok(())
+    }
+
+    /// The BRDF model being rendered, with its energy table when it has one.
+    pub fn shading(&self) -> &Shading {
+        &self.shading
+    }
+
+    /// Switches the BRDF model: a new specialization of the relight kernel (and energy table);
+    /// accumulation restarts. Nothing happens when the model is the same.
+    pub fn set_model(&mut self, model: &Model) -> Result<()> {
+        if *model == self.shading.model {
+            return Ok(());
+        }
+        let (relight, shading, energy) = relight_pipeline(&self.ctx, model)?;
+        let environment_set = relight.bind(1, &self._environment.bindings())?;
+        let relight_set = relight.bind(
+            0,
+            &[
+                Binding::Image(&self.surface),
+                Binding::Image(&self.resolved),
+                Binding::Image(&self.accumulation),
+                Binding::Image(&self.background),
+                Binding::Buffer(&energy),
+            ],
+        )?;
+        self.relight_set = relight_set;
+        self.environment_set = environment_set;
+        self.relight = relight;
+        self.shading = shading;
+        self._energy = energy;
         self.restart();
         Ok(())
     }

@@ -3,6 +3,7 @@
 use super::tonemap::Tonemap;
 use super::Lighting;
 use crate::material::Look;
+use crate::shading::model::Model;
 use crate::{Error, Result};
 use std::path::PathBuf;
 
@@ -22,6 +23,8 @@ pub struct Overrides {
     pub seed: Option<u32>,
     pub exposure: Option<f32>,
     pub tonemap: Option<Tonemap>,
+    /// `--model KEY=VALUE`, applied in order over the look's `[model]`.
+    pub model: Vec<String>,
 }
 
 /// Everything a render needs besides the g-buffer and the stacks.
@@ -34,6 +37,8 @@ pub struct Settings {
     pub seed: u32,
     pub exposure: f32,
     pub tonemap: Tonemap,
+    /// The BRDF model.
+    pub model: Model,
 }
 
 impl Settings {
@@ -59,7 +64,12 @@ impl Settings {
         if exposure.abs() > MAX_EXPOSURE {
             return Err(Error::input(format!("--exposure {exposure}: must be within ±{MAX_EXPOSURE} stops")));
         }
+        let mut model = look.model.unwrap_or_default();
+        for text in &overrides.model {
+            model.set_from_text(text).map_err(Error::input)?;
+        }
         Ok(Settings {
+            model,
             environment: overrides.environment.clone().or_else(|| env.file.clone()),
             lighting: Lighting {
                 rotation_degrees: finite("rotation", overrides.rotation.or(env.rotation).unwrap_or(0.0))?,

@@ -30,6 +30,7 @@ impl Labeller {
 
     /// Draws `text` with its top-left at (x, y), `size` pixels high, alpha-blended in `color`.
     /// Text that would run past `max_width` is cut short with an ellipsis.
+    #[allow(clippy::too_many_arguments)]
     pub fn draw(&self, image: &mut RgbaImage, text: &str, x: f32, y: f32, size: f32, color: [u8; 3], max_width: f32) {
         let text = self.fit(text, size, max_width);
         let font = self.font.as_scaled(PxScale::from(size));
@@ -47,9 +48,9 @@ impl Labeller {
                 let (px, py) = (bounds.min.x as i64 + gx as i64, bounds.min.y as i64 + gy as i64);
                 if px >= 0 && py >= 0 && (px as u32) < image.width() && (py as u32) < image.height() {
                     let pixel = image.get_pixel_mut(px as u32, py as u32);
-                    for k in 0..3 {
-                        let (under, over) = (pixel.0[k] as f32, color[k] as f32);
-                        pixel.0[k] = (under + (over - under) * coverage.clamp(0.0, 1.0)).round() as u8;
+                    for (channel, over) in pixel.0.iter_mut().zip(color) {
+                        let (under, over) = (*channel as f32, over as f32);
+                        *channel = (under + (over - under) * coverage.clamp(0.0, 1.0)).round() as u8;
                     }
                 }
             });

@@ -1,4 +1,6 @@
 //! Display transforms: exposure, tone map and the sRGB OETF.
+// The fits' constants are written as their sources publish them.
+#![allow(clippy::excessive_precision)]
 
 use glam::{Mat3, Vec3};
 use std::fmt;

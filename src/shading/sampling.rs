@@ -1,7 +1,8 @@
 //! Mirror of `glsl/include/sampling.glsl`: BRDF importance sampling and MIS.
 
-use super::brdf::{HalfVector, Lobes, View};
+use super::brdf::{expm1_accurate, log1p_accurate, log_accurate, HalfVector, Lobes, View};
 use super::common::{luminance, mix, INV_PI, ONE_MINUS_EPSILON, TWO_PI};
+use super::model::SpecularD;
 use glam::{Vec2, Vec3};
 
 /// Probabilities of picking each lobe for one-sample MIS; they sum to 1.
@@ -9,7 +10,7 @@ use glam::{Vec2, Vec3};
 pub struct LobeChoice {
     /// Diffuse, subsurface and sheen: cosine sampling.
     pub diffuse: f32,
-    /// GGX visible normals.
+    /// GGX visible normals, or the model's distribution of normals.
     pub specular: f32,
     /// GTR1 half vectors.
     pub clearcoat: f32,
@@ -17,11 +18,16 @@ pub struct LobeChoice {
 
 /// Picks lobes in proportion to an estimate of their reflectance at this view angle.
 pub fn choose_lobes(s: &Lobes, view: &View) -> LobeChoice {
-    let w_diffuse = (1.0 - s.metallic) * (luminance(s.base_color) + 0.25 * luminance(s.sheen_color));
+    let mut w_diffuse = (1.0 - s.metallic) * (luminance(s.base_color) + 0.25 * luminance(s.sheen_color));
+    if s.model.energy_compensation {
+        // The multiple-scattering lobe is nearly cosine-shaped; its albedo is F_ms·(1 − E(μv)).
+        w_diffuse += luminance(s.ms_fresnel) * view.ms_v;
+    }
     let w_specular = luminance(s.cspec0.lerp(Vec3::ONE, view.fv));
     let w_clearcoat = s.clearcoat * mix(0.04, 1.0, view.fv);
     let total = w_diffuse + w_specular + w_clearcoat;
-    if !(total > 0.0) {
+    // Written so that a NaN total also falls back to the diffuse lobe.
+    if total.is_nan() || total <= 0.0 {
         return LobeChoice { diffuse: 1.0, specular: 0.0, clearcoat: 0.0 };
     }
     LobeChoice { diffuse: w_diffuse / total, specular: w_specular / total, clearcoat: w_clearcoat / total }
@@ -54,9 +60,60 @@ pub fn sample_ggx_visible_normal(v_stretched: Vec3, ax: f32, ay: f32, azimuth: V
 /// pdf of l = reflect(−v, h) for visible-normal sampling: g(v)·D(h)/2.
 pub fn pdf_ggx_reflection(view: &View, hv: &HalfVector) -> f32 {
     if hv.h.z > 0.0 {
-        0.5 * view.g_spec * hv.d_spec
+        0.5 * view.g_vndf * hv.d_spec
     } else {
         0.0
+    }
+}
+
+/// A Beckmann normal, from the distribution of normals D(h)·cosθh.
+pub fn sample_beckmann_normal(ax: f32, ay: f32, azimuth: Vec2, u: f32) -> Vec3 {
+    let r = (-(1.0 - u).ln()).sqrt();
+    Vec3::new(ax * r * azimuth.x, ay * r * azimuth.y, 1.0).normalize()
+}
+
+/// A GTR-γ normal from D(h)·cosθh (Burley 2012, appendix B), accurate as α → 1.
+pub fn sample_gtr_normal(alpha2: f32, gamma: f32, azimuth: Vec2, u: f32) -> Vec3 {
+    let cos2 = if alpha2 >= 1.0 {
+        1.0 - u
+    } else {
+        let log_alpha2 = log_accurate(alpha2);
+        let one_minus_s = if (gamma - 1.0).abs() < 1e-4 {
+            -expm1_accurate(log_alpha2 * (1.0 - u))
+        } else {
+            let e = 1.0 - gamma;
+            -expm1_accurate(log1p_accurate((1.0 - u) * expm1_accurate(e * log_alpha2)) / e)
+        };
+        one_minus_s / (1.0 - alpha2)
+    };
+    let cos2 = cos2.clamp(0.0, 1.0);
+    ((1.0 - cos2).sqrt() * azimuth).extend(cos2.sqrt())
+}
+
+/// pdf of l = reflect(−v, h) when h is drawn from D(h)·cosθh: D(h)·|N·h|/(4·|v·h|).
+pub fn pdf_normal_reflection(d: f32, view: &View, h: Vec3) -> f32 {
+    let vh = view.v.dot(h).abs();
+    if vh > 0.0 {
+        d * h.z.abs() / (4.0 * vh)
+    } else {
+        0.0
+    }
+}
+
+/// pdf of the specular sampler of the model.
+pub fn pdf_specular_reflection(view: &View, hv: &HalfVector) -> f32 {
+    if view.model.specular_d == SpecularD::Gtr2 {
+        return pdf_ggx_reflection(view, hv);
+    }
+    pdf_normal_reflection(hv.d_spec, view, hv.h)
+}
+
+/// A specular half vector of the model: GGX visible normals, or the distribution of normals.
+pub fn sample_specular_normal(s: &Lobes, view: &View, azimuth: Vec2, u: f32) -> Vec3 {
+    match s.model.specular_d {
+        SpecularD::Beckmann => sample_beckmann_normal(s.ax, s.ay, azimuth, u),
+        SpecularD::Gtr => sample_gtr_normal(s.ax * s.ax, s.model.gtr_gamma, azimuth, u),
+        SpecularD::Gtr2 => sample_ggx_visible_normal(view.v_stretched, s.ax, s.ay, azimuth, u),
     }
 }
 
@@ -81,7 +138,7 @@ pub fn pdf_gtr1_reflection(view: &View, hv: &HalfVector) -> f32 {
 pub fn brdf_pdf(c: &LobeChoice, view: &View, l: Vec3, hv: &HalfVector) -> f32 {
     let mut pdf = c.diffuse * pdf_cosine(l);
     if c.specular > 0.0 {
-        pdf += c.specular * pdf_ggx_reflection(view, hv);
+        pdf += c.specular * pdf_specular_reflection(view, hv);
     }
     if c.clearcoat > 0.0 {
         pdf += c.clearcoat * pdf_gtr1_reflection(view, hv);
@@ -108,7 +165,7 @@ pub fn sample_brdf(s: &Lobes, c: &LobeChoice, view: &View, u: Vec2) -> Vec3 {
         return sample_cosine(phi, u.y);
     }
     let h = if lobe == 1 {
-        sample_ggx_visible_normal(view.v_stretched, s.ax, s.ay, phi, u.y)
+        sample_specular_normal(s, view, phi, u.y)
     } else {
         sample_gtr1_normal(s.cc_alpha2, s.cc_log2_alpha2, phi, u.y)
     };

@@ -113,7 +113,7 @@ impl Session {
         let masks: Vec<String> = gbuffer.masks.keys().cloned().collect();
         let packed = PackedStacks::pack(document.look(), objects.iter().copied(), &masks, &gbuffer_name)?;
         let settings = document.settings().clone();
-        let mut renderer = Renderer::new(ctx, &gbuffer, &environment)?;
+        let mut renderer = Renderer::with_model(ctx, &gbuffer, &environment, &settings.model)?;
         renderer.set_stacks(&packed)?;
         renderer.set_lighting(settings.lighting);
         renderer.set_seed(settings.seed);

@@ -80,7 +80,8 @@ impl Document {
         }
         let count = self.stack(object).map_or(0, |s| s.layers.len());
         check_layer(object, layer, count).map_err(Error::input)?;
-        let params = self.layer(object, layer).map(|l| l.params).unwrap_or_default();
+        // The eleven parameters only: a layer's complex IOR is its preset's, not the new one's.
+        let params = self.layer(object, layer).map(|l| Params { ior_edge: [0.0; 3], ..l.params }).unwrap_or_default();
         let defaults = Params::default();
         Ok(Preset {
             name: name.to_string(),
@@ -88,6 +89,7 @@ impl Document {
             tags: tags.to_vec(),
             params,
             set: Param::ALL.into_iter().filter(|&p| params.get(p) != defaults.get(p)).collect(),
+            ior: None,
         })
     }
 

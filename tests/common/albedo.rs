@@ -8,7 +8,7 @@
 
 use glam::Vec3;
 use lookdev::material::Params;
-use lookdev::shading::brdf::{disney_brdf, make_half_vector, make_lobes, make_view};
+use lookdev::shading::brdf::{disney_brdf, make_half_vector, make_lobes_with, make_view, Shading};
 use std::f64::consts::PI;
 
 struct Density {
@@ -68,7 +68,17 @@ pub fn directional_albedo(params: &Params, theta_v: f64) -> [f64; 3] {
 }
 
 pub fn directional_albedo_at(params: &Params, v: [f64; 3]) -> [f64; 3] {
-    let lobes = make_lobes(params);
+    directional_albedo_at_with(params, &Shading::default(), v)
+}
+
+/// The same for a BRDF model. The densities stay GGX's and GTR1's whatever the model's own
+/// distribution: they only need to cover the lobes, not to match them.
+pub fn directional_albedo_with(params: &Params, shading: &Shading, theta_v: f64) -> [f64; 3] {
+    directional_albedo_at_with(params, shading, [theta_v.sin(), 0.0, theta_v.cos()])
+}
+
+pub fn directional_albedo_at_with(params: &Params, shading: &Shading, v: [f64; 3]) -> [f64; 3] {
+    let lobes = make_lobes_with(params, shading);
     let a = mix(0.1, 0.001, params.clearcoat_gloss as f64);
     let density =
         Density { alpha_ggx: ((lobes.ax as f64) * (lobes.ay as f64)).sqrt(), alpha2_gtr1: (a * a).min(0.999_999) };

@@ -24,3 +24,21 @@ pub fn finish(ctx: Context) {
     drop(ctx);
     assert_eq!(counter.errors(), 0, "Vulkan validation reported errors (see stderr)");
 }
+
+/// The energy table a kernel specialized for `model` reads, built on the GPU as the renderer
+/// builds it (a placeholder of zeros when the model does not compensate), with the shading the
+/// Rust reference needs to mirror the kernel.
+pub fn model_shading(
+    ctx: &Context,
+    model: &lookdev::shading::model::Model,
+) -> (lookdev::gpu::Buffer, lookdev::shading::brdf::Shading) {
+    use lookdev::shading::energy::EnergyTable;
+    let table = if model.energy_compensation {
+        lookdev::render::energy::build(ctx, model).unwrap()
+    } else {
+        EnergyTable::placeholder()
+    };
+    let buffer = lookdev::gpu::Buffer::with_data(ctx, bytemuck::cast_slice(&table.values)).unwrap();
+    let energy = model.energy_compensation.then(|| std::sync::Arc::new(table));
+    (buffer, lookdev::shading::brdf::Shading::new(*model, energy))
+}
