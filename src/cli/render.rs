@@ -2,13 +2,16 @@
 
 use super::inputs::{self, DisplayArgs, LightingArgs, SamplingArgs};
 use super::progress::Progress;
+use crate::gpu::Context;
+use crate::render::compare::{self, Summary};
 use crate::render::output::{self, OutputFormat};
-use crate::render::progressive;
+use crate::render::progressive::{self, RenderStats};
 use crate::render::scene::Scene;
+use crate::render::settings::Overrides;
 use crate::render::Renderer;
 use crate::{Error, Result};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -36,6 +39,42 @@ pub struct RenderArgs {
     /// Output image: .png (exposure, tone map, sRGB) or .exr (linear radiance).
     #[arg(long, value_name = "FILE.png|FILE.exr")]
     pub out: PathBuf,
+    /// Render twice and compare: A is this render, B the same with the look B.toml; or, without
+    /// a file, A is the look's own BRDF model and B the model with the --model changes. Writes A
+    /// and B side by side to --out, their ΔE*ab to <out>.diff.png, and prints the statistics.
+    #[arg(long, value_name = "B.toml", num_args = 0..=1)]
+    pub compare: Option<Option<PathBuf>>,
+}
+
+/// One render, read back for output.
+struct Rendered {
+    width: u32,
+    height: u32,
+    /// Display pixels, RGBA8 sRGB, after exposure and the tone map.
+    display: Vec<u8>,
+    /// Linear radiance, for EXR output.
+    radiance: Option<Vec<[f32; 4]>>,
+    stats: RenderStats,
+}
+
+/// Relights `scene` on `ctx` and reads back what the output needs.
+fn render(ctx: &Context, scene: &Scene, radiance: bool, label: &str, quiet: bool) -> Result<Rendered> {
+    scene.check_device(ctx.info())?;
+    let settings = &scene.settings;
+    let mut renderer = Renderer::with_model(ctx, &scene.gbuffer, &scene.environment, &settings.model)?;
+    renderer.set_stacks(&scene.stacks)?;
+    renderer.set_lighting(settings.lighting);
+    renderer.set_seed(settings.seed);
+    let mut progress = Progress::new(settings.spp as u64, label, quiet);
+    let stats = progressive::accumulate(&mut renderer, settings.spp, |done| progress.update(done as u64))?;
+    progress.finish();
+    Ok(Rendered {
+        width: renderer.width,
+        height: renderer.height,
+        display: renderer.read_display(settings.exposure, settings.tonemap)?,
+        radiance: if radiance { Some(renderer.read_radiance()?) } else { None },
+        stats,
+    })
 }
 
 pub fn run(args: RenderArgs) -> Result<()> {
@@ -47,37 +86,22 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     let overrides = inputs::overrides(&args.lighting, &args.sampling, &args.display);
     let sets = inputs::parse_sets(&args.set)?;
-    let scene =
-        Scene::load(args.gbuffer.as_deref(), args.look.as_deref(), &sets, &overrides, &args.lighting.load_options())?;
+    let load = |look: Option<&Path>, overrides: &Overrides| {
+        Scene::load(args.gbuffer.as_deref(), look, &sets, overrides, &args.lighting.load_options())
+    };
+    if let Some(second) = &args.compare {
+        return run_compare(&args, format, second.as_deref(), &overrides, load);
+    }
+    let scene = load(args.look.as_deref(), &overrides)?;
 
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
-    scene.check_device(ctx.info())?;
     let device_name = ctx.info().name.clone();
     let settings = &scene.settings;
-    let stats = {
-        let mut renderer = Renderer::with_model(&ctx, &scene.gbuffer, &scene.environment, &settings.model)?;
-        renderer.set_stacks(&scene.stacks)?;
-        renderer.set_lighting(settings.lighting);
-        renderer.set_seed(settings.seed);
-        let mut progress = Progress::new(settings.spp as u64, "rendering", args.quiet);
-        let stats = progressive::accumulate(&mut renderer, settings.spp, |done| progress.update(done as u64))?;
-        progress.finish();
-        let (width, height) = (renderer.width, renderer.height);
-        match format {
-            OutputFormat::Exr => {
-                let radiance = renderer.read_radiance()?;
-                output::write_exr(&args.out, width, height, &radiance, settings.lighting.background)?
-            }
-            OutputFormat::Png => {
-                let pixels = renderer.read_display(settings.exposure, settings.tonemap)?;
-                output::write_png(&args.out, width, height, &pixels, !settings.lighting.background)?
-            }
-        }
-        stats
-    };
+    let rendered = render(&ctx, &scene, format == OutputFormat::Exr, "rendering", args.quiet)?;
     drop(ctx);
     super::check_validation(&counter)?;
+    write(&args.out, format, &rendered, settings.lighting.background)?;
     if !args.quiet {
         eprintln!(
             "lookdev: wrote {} ({}x{}, {} spp, {:.2} s on {device_name})",
@@ -85,8 +109,117 @@ pub fn run(args: RenderArgs) -> Result<()> {
             scene.gbuffer.width,
             scene.gbuffer.height,
             settings.spp,
-            stats.wall.as_secs_f64()
+            rendered.stats.wall.as_secs_f64()
         );
     }
     Ok(())
+}
+
+fn write(path: &Path, format: OutputFormat, rendered: &Rendered, background: bool) -> Result<()> {
+    let (width, height) = (rendered.width, rendered.height);
+    match (format, &rendered.radiance) {
+        (OutputFormat::Exr, Some(radiance)) => output::write_exr(path, width, height, radiance, background),
+        _ => output::write_png(path, width, height, &rendered.display, !background),
+    }
+}
+
+/// `--compare`: renders A and B, writes them side by side and their difference, and prints the
+/// difference's statistics.
+fn run_compare(
+    args: &RenderArgs,
+    format: OutputFormat,
+    second_look: Option<&Path>,
+    overrides: &Overrides,
+    load: impl Fn(Option<&Path>, &Overrides) -> Result<Scene>,
+) -> Result<()> {
+    let look_name = |look: Option<&Path>| match look.and_then(Path::file_name) {
+        Some(name) => name.to_string_lossy().into_owned(),
+        None if args.gbuffer.is_none() => "built-in look".to_string(),
+        None => "default material".to_string(),
+    };
+    let (a, b) = match second_look {
+        Some(b_look) => (load(args.look.as_deref(), overrides)?, load(Some(b_look), overrides)?),
+        None if !overrides.model.is_empty() => {
+            let own_model = Overrides { model: Vec::new(), ..overrides.clone() };
+            (load(args.look.as_deref(), &own_model)?, load(args.look.as_deref(), overrides)?)
+        }
+        None => {
+            return Err(Error::input(
+                "--compare needs something to compare with: a second look (--compare B.toml) or --model KEY=VALUE",
+            ))
+        }
+    };
+    let label = |scene: &Scene, look: Option<&Path>| format!("{}, model: {}", look_name(look), scene.settings.model);
+    let a_label = label(&a, args.look.as_deref());
+    let b_label = label(&b, second_look.or(args.look.as_deref()));
+
+    let ctx = super::context(args.device.clone())?;
+    let counter = ctx.validation_counter();
+    let device_name = ctx.info().name.clone();
+    let exr = format == OutputFormat::Exr;
+    let first = render(&ctx, &a, exr, "rendering A", args.quiet)?;
+    let second = render(&ctx, &b, exr, "rendering B", args.quiet)?;
+    drop(ctx);
+    super::check_validation(&counter)?;
+
+    let (width, height) = (first.width, first.height);
+    let differences = compare::delta_e_image(&first.display, &second.display);
+    let coverage = &a.gbuffer.coverage;
+    let summary = Summary::of(&differences, |i| coverage[i] > 0.0);
+    let diff_path = diff_path(&args.out);
+    output::write_png_image(&diff_path, &compare::heat_map(&differences, width, height))?;
+    match format {
+        OutputFormat::Exr => {
+            // Data, not a picture: A's pixels then B's, in one image twice as wide.
+            let (ra, rb) =
+                (first.radiance.as_ref().expect("read for EXR"), second.radiance.as_ref().expect("read for EXR"));
+            let rows = (0..height as usize).flat_map(|y| {
+                let row = y * width as usize..(y + 1) * width as usize;
+                ra[row.clone()].iter().chain(&rb[row]).copied()
+            });
+            let both: Vec<[f32; 4]> = rows.collect();
+            output::write_exr(&args.out, 2 * width, height, &both, a.settings.lighting.background)?;
+        }
+        OutputFormat::Png => {
+            let image =
+                |r: &Rendered| image::RgbaImage::from_raw(width, height, r.display.clone()).expect("sizes match");
+            output::write_png_image(
+                &args.out,
+                &compare::side_by_side(image(&first), &a_label, image(&second), &b_label),
+            )?;
+        }
+    }
+    // The statistics are the command's result, so they print even with --quiet.
+    match summary {
+        Some(s) => println!(
+            "ΔE*ab (CIELAB, D65) of B against A over {} shaded pixels: mean {:.2}, median {:.2}, 95th percentile {:.2}, \
+             max {:.2}; {:.1}% at or above {} (just noticeable)",
+            s.pixels,
+            s.mean,
+            s.median,
+            s.p95,
+            s.max,
+            100.0 * s.noticeable,
+            compare::JUST_NOTICEABLE
+        ),
+        None => println!("ΔE*ab: the g-buffer has no shaded pixels to compare"),
+    }
+    if !args.quiet {
+        eprintln!(
+            "lookdev: wrote {} (A: {a_label}; B: {b_label}) and {} ({}x{}, {} spp each, {:.2} s on {device_name})",
+            args.out.display(),
+            diff_path.display(),
+            width,
+            height,
+            a.settings.spp,
+            (first.stats.wall + second.stats.wall).as_secs_f64()
+        );
+    }
+    Ok(())
+}
+
+/// `<out>.diff.png` beside `--out`: `shots/ball.png` gives `shots/ball.diff.png`.
+fn diff_path(out: &Path) -> PathBuf {
+    let stem = out.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    out.with_file_name(format!("{stem}.diff.png"))
 }

@@ -1,6 +1,7 @@
 //! Rendering: parameter resolve, progressive relighting, accumulation and display transforms.
 
 pub mod batch;
+pub mod compare;
 pub mod energy;
 pub mod output;
 pub mod progressive;
