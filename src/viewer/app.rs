@@ -580,9 +580,7 @@ impl Running {
             session.device_name(),
             session.samples(),
             self.clock.rendering_summary(),
-            (session.progressive.samples_per_second()
-                + session.compare_progressive().map_or(0.0, |b| b.samples_per_second()))
-                / 1e6
+            session.progressive.samples_per_second_with(session.compare_progressive()) / 1e6
         )
     }
 

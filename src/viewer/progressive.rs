@@ -98,12 +98,16 @@ impl Progressive {
         Ok(true)
     }
 
-    /// Pixel samples per second while relighting, over the current accumulation.
-    pub fn samples_per_second(&self) -> f64 {
-        if self.busy.is_zero() {
+    /// Pixel samples per second while relighting, over the current accumulation, of this and
+    /// `other` together (an A/B split's two renderers,
+    /// which relight in turn): all their samples over all their relighting time.
+    pub fn samples_per_second_with(&self, other: Option<&Progressive>) -> f64 {
+        let (samples, busy) = other
+            .map_or((self.pixel_samples, self.busy), |b| (self.pixel_samples + b.pixel_samples, self.busy + b.busy));
+        if busy.is_zero() {
             0.0
         } else {
-            self.pixel_samples / self.busy.as_secs_f64()
+            samples / busy.as_secs_f64()
         }
     }
 }

@@ -230,7 +230,8 @@ impl Interface {
             let state = if samples >= target { "done" } else { "rendering" };
             ui.label(format!("{samples} / {target} spp ({state})"));
             ui.separator();
-            ui.label(format!("{:.1} M samples/s", session.progressive.samples_per_second() / 1e6));
+            let rate = session.progressive.samples_per_second_with(session.compare_progressive());
+            ui.label(format!("{:.1} M samples/s", rate / 1e6));
             ui.separator();
             ui.label(format!("frame {:.1} ms", frame.figures.frame.as_secs_f64() * 1e3));
             if let Some(first) = session.first_pass_after_change {
