@@ -157,6 +157,7 @@ impl Case {
             .find(|l| l.starts_with("lookdev: screenshot") && l.contains(name))
             .unwrap_or_else(|| panic!("no screenshot reported: {stdout}"));
         let placement = line.split("the image is at ").nth(1).expect("the placement is reported");
+        let placement = placement.split(';').next().unwrap();
         let numbers: Vec<f32> = placement
             .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
             .filter(|s| !s.is_empty())
@@ -497,4 +498,155 @@ fn preset_thumbnails_render_once_and_are_kept_on_disk() {
     assert_ne!(thumbnails::file_name(&gold), thumbnails::file_name(&chrome));
     drop(thumbnails);
     common::gpu::finish(ctx);
+}
+
+/// Rows at the top of a split image that carry the halves' labels, and columns either side of
+/// the divider line: left out when comparing halves with renders.
+const LABEL_ROWS: u32 = 28;
+const DIVIDER_MARGIN: u32 = 3;
+
+/// The split column a screenshot report gives, and its labels.
+fn split_of(output: &Output, name: &str) -> Option<(u32, String)> {
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let line = stdout.lines().find(|l| l.starts_with("lookdev: screenshot") && l.contains(name))?;
+    let rest = line.split("; split at image column ").nth(1)?;
+    let (column, labels) = rest.split_once(' ').unwrap();
+    Some((column.parse().unwrap(), labels.to_string()))
+}
+
+/// The part of `image` in columns `columns`, below the label rows.
+fn region(image: &RgbImage, columns: std::ops::Range<u32>) -> RgbImage {
+    image::imageops::crop_imm(image, columns.start, LABEL_ROWS, columns.end - columns.start, SIZE - LABEL_ROWS)
+        .to_image()
+}
+
+/// Left of the divider the shot is `a`, right of it `b`, each as `lookdev render` makes them.
+fn assert_halves(shot: &RgbImage, column: u32, a: &RgbImage, b: &RgbImage) {
+    let left = 0..column - DIVIDER_MARGIN;
+    let right = column + DIVIDER_MARGIN..SIZE;
+    assert_matches_render(&region(shot, left.clone()), &region(a, left.clone()));
+    assert_matches_render(&region(shot, right.clone()), &region(b, right.clone()));
+    // The halves are told apart: a swap, or B ignored, would fail the lines above.
+    assert_differs(&region(a, right.clone()), &region(b, right), "B differs from A");
+}
+
+#[test]
+fn the_split_view_shows_a_beside_another_model_and_each_half_matches_lookdev_render() {
+    let Some(case) = Case::new() else { return };
+    let mut seeded = Look::load(&case.path("look.toml")).unwrap();
+    seeded.render.seed = Some(3);
+    case.write("seeded.toml", &seeded.to_toml());
+    let a = case.render("seeded.toml", 4, "a.png");
+    let model = ["--model", "diffuse=lambert", "--model", "fresnel=conductor", "--model", "specular_d=beckmann"];
+    let args = [["render", "--gbuffer", "g.exr", "--look", "seeded.toml", "--spp", "4", "--quiet"].as_slice(), &model]
+        .concat();
+    assert_success(&case.command(&[args.as_slice(), &["--out", "b.png"]].concat()).output().unwrap());
+    let b = image::open(case.path("b.png")).unwrap().into_rgb8();
+
+    // From the command line, the divider moved by the script; then off, back to the plain image.
+    case.write(
+        "split.script",
+        "divider 0.3\nwait-spp 4\nscreenshot third.png\ndivider 0.5\nwait-spp 4\nscreenshot half.png\n\
+         compare off\nwait-spp 4\nscreenshot off.png\n",
+    );
+    let flags = ["--compare-model", "diffuse=lambert", "--compare-model", "fresnel=conductor"];
+    let mut view = vec!["seeded.toml", "--script", "split.script", "--exit-after-spp", "4"];
+    view.extend(flags);
+    view.extend(["--compare-model", "specular_d=beckmann"]);
+    let output = case.view(&view);
+    assert_success(&output);
+    let (column, labels) = split_of(&output, "half.png").expect("the split is reported");
+    assert_eq!(column, SIZE / 2);
+    assert!(
+        labels.contains("A: default") && labels.contains("B: diffuse=lambert specular_d=beckmann fresnel=conductor"),
+        "{labels}"
+    );
+    assert_halves(&case.screenshot_image(&output, "half.png"), column, &a, &b);
+    let (third, _) = split_of(&output, "third.png").unwrap();
+    assert_eq!(third, 48);
+    assert_halves(&case.screenshot_image(&output, "third.png"), third, &a, &b);
+    assert!(split_of(&output, "off.png").is_none(), "compare off ends the split");
+    assert_matches_render(&case.screenshot_image(&output, "off.png"), &a);
+
+    // From a script, and swapped: A takes B's model, B A's.
+    case.write(
+        "swap.script",
+        "compare model diffuse=lambert fresnel=conductor specular_d=beckmann\ncompare swap\ndivider 0.5\n",
+    );
+    let output =
+        case.view(&["seeded.toml", "--script", "swap.script", "--exit-after-spp", "4", "--screenshot", "s.png"]);
+    assert_success(&output);
+    let (column, labels) = split_of(&output, "s.png").unwrap();
+    assert!(labels.starts_with("(A: diffuse=lambert") && labels.contains("B: default"), "{labels}");
+    assert_halves(&case.screenshot_image(&output, "s.png"), column, &b, &a);
+}
+
+#[test]
+fn the_split_view_shows_a_beside_another_look_under_the_same_light() {
+    let Some(case) = Case::new() else { return };
+    // B: chrome ball, lambert pedestal, its own model; A's seed, rotation and spp apply to both.
+    case.write(
+        "b.toml",
+        "[model]\ndiffuse = \"lambert\"\n\n[[object]]\n[[object.layer]]\npreset = \"red-plastic\"\n\n\
+         [[object]]\nid = 1\n[[object.layer]]\npreset = \"chrome\"\n",
+    );
+    case.write("split.script", "rotate 40\nwait-spp 4\n");
+    let output = case.view(&[
+        "look.toml",
+        "--compare-look",
+        "b.toml",
+        "--seed",
+        "5",
+        "--script",
+        "split.script",
+        "--exit-after-spp",
+        "4",
+        "--screenshot",
+        "shot.png",
+    ]);
+    assert_success(&output);
+    let (column, labels) = split_of(&output, "shot.png").expect("the split is reported");
+    assert!(labels.contains("A: look.toml") && labels.contains("B: b.toml · diffuse=lambert"), "{labels}");
+    let lit = |name: &str, text: &str| {
+        let mut look = Look::load(&case.path(text)).unwrap();
+        look.render.seed = Some(5);
+        look.environment.rotation = Some(40.0);
+        case.write(name, &look.to_toml());
+        case.render(name, 4, &format!("{name}.png"))
+    };
+    let a = lit("a.toml", "look.toml");
+    let b = lit("b-lit.toml", "b.toml");
+    assert_halves(&case.screenshot_image(&output, "shot.png"), column, &a, &b);
+}
+
+#[test]
+fn bad_compare_inputs_are_one_line_errors() {
+    let Some(case) = Case::new() else { return };
+    case.write("broken.toml", "[[object]\n");
+    for (args, expected) in [
+        (vec!["look.toml", "--compare-look", "missing.toml"], "missing.toml"),
+        (vec!["look.toml", "--compare-look", "broken.toml"], "broken.toml"),
+        (vec!["look.toml", "--compare-model", "diffuse=lamber"], "--compare-model diffuse=lamber"),
+        (vec!["look.toml", "--compare-model", "gtr_gamma"], "--compare-model gtr_gamma: expected KEY=VALUE"),
+    ] {
+        let output = case.view(&args);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {}", stderr(&output));
+        let text = stderr(&output);
+        assert!(text.contains(expected) && !text.contains("panicked"), "{args:?}: {text}");
+        assert_eq!(text.trim_end().lines().count(), 1, "one line: {text}");
+    }
+    // A mask B's look needs and the g-buffer lacks, found before the window opens.
+    case.write("masked.toml", "[[object]]\n[[object.layer]]\npreset = \"gold\"\nmask = \"nosuch\"\n");
+    let output = case.view(&["look.toml", "--compare-look", "masked.toml"]);
+    assert_eq!(output.status.code(), Some(2), "{}", stderr(&output));
+    assert!(stderr(&output).contains("nosuch"), "{}", stderr(&output));
+    // While running, a script's bad look names the line.
+    case.write("bad.script", "compare look missing.toml\n");
+    let output = case.view(&["look.toml", "--script", "bad.script"]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        stderr(&output).contains("bad.script:1:") && stderr(&output).contains("missing.toml"),
+        "{}",
+        stderr(&output)
+    );
 }

@@ -39,6 +39,13 @@ pub struct ViewArgs {
     /// Run interface actions from a file, one per line (see the README).
     #[arg(long, value_name = "FILE")]
     pub script: Option<PathBuf>,
+    /// Open with an A/B split: B is the look under its model with KEY=VALUE changed (the keys of
+    /// --model; repeatable).
+    #[arg(long = "compare-model", value_name = "KEY=VALUE", conflicts_with = "compare_look")]
+    pub compare_model: Vec<String>,
+    /// Open with an A/B split: B is this look (its stacks and model, A's lighting and settings).
+    #[arg(long, value_name = "B.toml")]
+    pub compare_look: Option<PathBuf>,
 }
 
 pub fn run(args: ViewArgs) -> Result<()> {
@@ -58,6 +65,10 @@ pub fn run(args: ViewArgs) -> Result<()> {
             return Err(Error::input(format!("--window-size {size:?}: the window must be 320x240 to 16384x16384")));
         }
     };
+    let mut model = crate::shading::model::Model::default();
+    for key in &args.compare_model {
+        model.set_from_flag("--compare-model", key).map_err(Error::input)?;
+    }
     let sets = inputs::parse_sets(&args.set)?;
     let overrides = inputs::overrides(&args.lighting, &args.sampling, &args.display);
     open(args, sets, overrides, window_size)
@@ -87,6 +98,8 @@ fn open(
         screenshot: args.screenshot,
         exit_after_spp: args.exit_after_spp,
         script,
+        compare_model: args.compare_model,
+        compare_look: args.compare_look,
     })
 }
 

@@ -218,21 +218,27 @@ impl Model {
 
     /// Parses and applies `--model KEY=VALUE`: names bare, numbers and true/false as written.
     pub fn set_from_text(&mut self, text: &str) -> Result<(), String> {
+        self.set_from_flag("--model", text)
+    }
+
+    /// [`Model::set_from_text`] for another flag or command that takes the same `KEY=VALUE`,
+    /// which its errors name (`--compare-model`, a script's `compare model`).
+    pub fn set_from_flag(&mut self, flag: &str, text: &str) -> Result<(), String> {
         let (key, value) =
-            text.split_once('=').ok_or_else(|| format!("--model {text}: expected KEY=VALUE, e.g. diffuse=lambert"))?;
+            text.split_once('=').ok_or_else(|| format!("{flag} {text}: expected KEY=VALUE, e.g. diffuse=lambert"))?;
         let (key, value) = (key.trim(), value.trim());
         let parsed = match key {
             "gtr_gamma" => ModelValue::Number(
-                value.parse::<f64>().map_err(|_| format!("--model {text}: gtr_gamma takes a number"))?,
+                value.parse::<f64>().map_err(|_| format!("{flag} {text}: gtr_gamma takes a number"))?,
             ),
             "energy_compensation" => match value {
                 "true" | "on" | "1" => ModelValue::Bool(true),
                 "false" | "off" | "0" => ModelValue::Bool(false),
-                _ => return Err(format!("--model {text}: energy_compensation takes true or false")),
+                _ => return Err(format!("{flag} {text}: energy_compensation takes true or false")),
             },
             _ => ModelValue::Text(value),
         };
-        self.set(key, parsed).map_err(|e| format!("--model {text}: {e}"))
+        self.set(key, parsed).map_err(|e| format!("{flag} {text}: {e}"))
     }
 
     /// The value of every key, as a `[model]` table would write it.

@@ -47,6 +47,23 @@ pub enum Action {
     Quit,
     /// The answer to the unsaved-edits question.
     Answer(Answer),
+    /// Starts, changes or ends the A/B split.
+    Compare(Compare),
+    /// Moves the split's divider: a fraction of the image's width, from the left.
+    Divider(f32),
+}
+
+/// What to show as B, beside the edited look (A).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Compare {
+    /// A's look under A's model with these `KEY=VALUE` changes (the keys of `--model`).
+    Model(Vec<String>),
+    /// Another look file.
+    Look(PathBuf),
+    /// Swap A and B.
+    Swap,
+    /// Back to the plain image.
+    Off,
 }
 
 /// What to do with unsaved edits before they would be lost.

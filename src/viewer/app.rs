@@ -3,7 +3,7 @@
 //! Carrying out the actions before relighting means an edit's first band is in the very frame
 //! that made it.
 
-use super::action::{Action, Answer};
+use super::action::{Action, Answer, Compare};
 use super::gui::Gui;
 use super::presenter::Presenter;
 use super::script::{ScriptRunner, Step};
@@ -78,6 +78,12 @@ impl Inputs {
         let masks: Vec<String> = gbuffer.masks.keys().cloned().collect();
         PackedStacks::pack(&look, covered.iter().copied(), &masks, &gbuffer_name)?;
         unused_stack_warnings(&look, &covered, &gbuffer_name).into_iter().for_each(crate::warn);
+        // B's inputs are checked here too, so that a bad one is an error before a window opens.
+        model_with(settings.model, &options.compare_model, "--compare-model")?;
+        if let Some(path) = &options.compare_look {
+            let b = Look::load(path)?;
+            PackedStacks::pack(&b, covered.iter().copied(), &masks, &gbuffer_name)?;
+        }
         let mut document = Document::new(look, options.look.clone(), settings);
         document.select(initial_selection(&document, &covered));
         Ok(Inputs { gbuffer, gbuffer_name, document, environment })
@@ -204,6 +210,12 @@ impl Running {
             inputs.environment,
             options.env_options,
         )?;
+        if let Some(path) = &options.compare_look {
+            session.compare_look(path)?;
+        } else if !options.compare_model.is_empty() {
+            let model = model_with(session.document.settings().model, &options.compare_model, "--compare-model")?;
+            session.compare_model(model)?;
+        }
         if let Some(spp) = options.exit_after_spp {
             session.override_target(spp);
         }
@@ -275,11 +287,21 @@ impl Running {
         if !finishing {
             self.script_step()?;
         }
-        let view_texture = self.gui.view_texture(self.session.display_image())?;
+        let view_texture = self.gui.view_texture(0, self.session.display_image())?;
+        let compare_texture = match self.session.compare_image() {
+            Some(image) => Some(self.gui.view_texture(1, image)?),
+            None => {
+                self.gui.release_view_texture(1);
+                None
+            }
+        };
+        // B's textures now name only a live image (or none): a replaced B can go.
+        self.session.drop_retired()?;
         let mut actions = Vec::new();
         let frame = Frame {
             session: &self.session,
             view_texture,
+            compare_texture,
             pending: self.pending.as_ref(),
             figures: FrameFigures { frame: self.clock.recent_mean() },
         };
@@ -432,6 +454,13 @@ impl Running {
                     self.quit = true;
                 }
             }
+            Action::Compare(compare) => return self.compare(compare),
+            Action::Divider(at) => {
+                if !(at.is_finite() && (0.0..=1.0).contains(&at)) {
+                    return Err(Error::input(format!("divider {at} is outside [0, 1]")));
+                }
+                self.session.divider = at;
+            }
             Action::Answer(answer) => {
                 let pending = self.pending.take().ok_or_else(|| Error::input("there is no question to answer"))?;
                 match answer {
@@ -450,6 +479,34 @@ impl Running {
             }
         }
         Ok(None)
+    }
+
+    /// Starts, changes, swaps or ends the A/B split.
+    fn compare(&mut self, compare: Compare) -> Result<Option<String>> {
+        match compare {
+            Compare::Model(keys) => {
+                let model = model_with(self.session.document.settings().model, &keys, "compare model")?;
+                self.session.compare_model(model)?;
+            }
+            Compare::Look(path) => self.session.compare_look(&path)?,
+            Compare::Off => self.session.compare_off(),
+            Compare::Swap => match self.session.compare_subject().map(|s| s.look_path().map(Path::to_path_buf)) {
+                None => return Err(Error::input("swap: nothing is being compared")),
+                Some(None) => self.session.swap_models()?,
+                Some(Some(b_path)) => {
+                    // A opens B's file and B shows A's: A's edits must be saved first, or be lost.
+                    let document = &self.session.document;
+                    let a_path = match document.path() {
+                        Some(path) if !document.is_dirty() => path.to_path_buf(),
+                        Some(_) => return Err(Error::input("swap: the look has unsaved edits; save them first")),
+                        None => return Err(Error::input("swap: the look has no file; save it first")),
+                    };
+                    self.open_look(&b_path)?;
+                    self.session.compare_look(&a_path)?;
+                }
+            },
+        }
+        Ok(self.session.compare_labels().map(|(a, b)| format!("comparing {a} | {b}")))
     }
 
     /// Does what the unsaved-edits question held back.
@@ -490,9 +547,12 @@ impl Running {
         }
         for path in &paths {
             crate::render::output::write_png_image(path, &image)?;
-            let placement = self.interface.placement.map_or(String::new(), |p| {
+            let mut placement = self.interface.placement.map_or(String::new(), |p| {
                 format!("; the image is at {},{} size {}x{} scale {}", p.x, p.y, p.width, p.height, p.scale)
             });
+            if let (Some(column), Some((a, b))) = (self.session.split_column(), self.session.compare_labels()) {
+                placement += &format!("; split at image column {column} ({a} | {b})");
+            }
             println!(
                 "lookdev: screenshot {} ({}x{} window, {} spp{placement})",
                 path.display(),
@@ -520,7 +580,7 @@ impl Running {
             session.device_name(),
             session.samples(),
             self.clock.rendering_summary(),
-            session.progressive.samples_per_second() / 1e6
+            session.progressive.samples_per_second_with(session.compare_progressive()) / 1e6
         )
     }
 
@@ -533,6 +593,18 @@ impl Running {
             self.title = title;
         }
     }
+}
+
+/// `model` with `KEY=VALUE` changes; errors name `flag`.
+fn model_with(
+    mut model: crate::shading::model::Model,
+    keys: &[String],
+    flag: &str,
+) -> Result<crate::shading::model::Model> {
+    for key in keys {
+        model.set_from_flag(flag, key).map_err(Error::input)?;
+    }
+    Ok(model)
 }
 
 /// The layer the selection points at.

@@ -14,7 +14,8 @@ pub struct Gui {
     pub egui: egui::Context,
     state: egui_winit::State,
     renderer: Renderer<egui_ash_renderer::allocator::DefaultAllocator>,
-    view_texture: Option<ViewTexture>,
+    /// The rendered views: A's, and B's while comparing.
+    view_textures: [Option<ViewTexture>; 2],
 }
 
 /// The rendered view as a texture egui can draw: a sampler set over the display image.
@@ -46,7 +47,7 @@ impl Gui {
             Options { in_flight_frames: 1, srgb_framebuffer: true, ..Options::default() },
         )
         .map_err(renderer_error)?;
-        Ok(Gui { ctx: ctx.clone(), egui, state, renderer, view_texture: None })
+        Ok(Gui { ctx: ctx.clone(), egui, state, renderer, view_textures: [None, None] })
     }
 
     /// Passes a window event to egui; true when egui used it.
@@ -54,14 +55,14 @@ impl Gui {
         self.state.on_window_event(window, event).consumed
     }
 
-    /// The texture id of the rendered view, made (or remade) for `image`.
-    pub fn view_texture(&mut self, image: &Image) -> Result<egui::TextureId> {
-        if let Some(texture) = &self.view_texture {
+    /// The texture id of rendered view `slot` (0: A, 1: B), made (or remade) for `image`.
+    pub fn view_texture(&mut self, slot: usize, image: &Image) -> Result<egui::TextureId> {
+        if let Some(texture) = &self.view_textures[slot] {
             if texture.image_view == image.srgb_view {
                 return Ok(texture.id);
             }
         }
-        self.release_view_texture();
+        self.release_view_texture(slot);
         let device = &self.ctx.device;
         let layout = egui_ash_renderer::vulkan::create_vulkan_descriptor_set_layout(device).map_err(renderer_error)?;
         let sizes =
@@ -93,12 +94,13 @@ impl Gui {
             .image_info(&info);
         unsafe { device.update_descriptor_sets(&[write], &[]) };
         let id = self.renderer.add_user_texture(set);
-        self.view_texture = Some(ViewTexture { id, pool, layout, sampler, image_view: image.srgb_view });
+        self.view_textures[slot] = Some(ViewTexture { id, pool, layout, sampler, image_view: image.srgb_view });
         Ok(id)
     }
 
-    fn release_view_texture(&mut self) {
-        if let Some(texture) = self.view_texture.take() {
+    /// Lets go of rendered view `slot`'s texture, if it has one.
+    pub fn release_view_texture(&mut self, slot: usize) {
+        if let Some(texture) = self.view_textures[slot].take() {
             self.renderer.remove_user_texture(texture.id);
             let device = &self.ctx.device;
             unsafe {
@@ -175,6 +177,7 @@ impl Drop for Gui {
         unsafe {
             let _ = self.ctx.device.device_wait_idle();
         }
-        self.release_view_texture();
+        self.release_view_texture(0);
+        self.release_view_texture(1);
     }
 }

@@ -10,6 +10,7 @@
 
 mod action;
 mod app;
+mod compare;
 mod gui;
 mod presenter;
 mod progressive;
@@ -42,6 +43,11 @@ pub struct ViewOptions {
     pub screenshot: Option<PathBuf>,
     pub exit_after_spp: Option<u32>,
     pub script: Option<Script>,
+    /// `--compare-model KEY=VALUE`: open with an A/B split, B being the look under A's model
+    /// with these keys changed.
+    pub compare_model: Vec<String>,
+    /// `--compare-look FILE`: open with an A/B split, B being this look.
+    pub compare_look: Option<PathBuf>,
 }
 
 /// The window's default inner size: room for both side panels and a 720p-tall view.

@@ -7,8 +7,8 @@ use crate::render::Renderer;
 use crate::Result;
 use std::time::{Duration, Instant};
 
-/// Relighting time allowed per frame.
-const FRAME_BUDGET: Duration = Duration::from_millis(25);
+/// Relighting time allowed per frame, shared by the renderers on screen (two in an A/B split).
+pub const FRAME_BUDGET: Duration = Duration::from_millis(25);
 /// The smallest band, so a slow device still makes progress each frame.
 const MIN_BAND_ROWS: u32 = 8;
 /// Samples per band once the first pass has landed: fewer, longer dispatches amortise each
@@ -17,6 +17,8 @@ const SAMPLES_PER_BAND: u32 = 4;
 
 /// Where the sweep is, how fast rows relight, and the figures the status bar shows.
 pub struct Progressive {
+    /// This renderer's share of [`FRAME_BUDGET`].
+    budget: Duration,
     cursor: u32,
     /// Seconds to relight one row with one sample (a running average).
     row_seconds: f64,
@@ -31,6 +33,7 @@ pub struct Progressive {
 impl Progressive {
     pub fn new() -> Progressive {
         Progressive {
+            budget: FRAME_BUDGET,
             cursor: 0,
             row_seconds: 0.0,
             started: Instant::now(),
@@ -38,6 +41,11 @@ impl Progressive {
             pixel_samples: 0.0,
             busy: Duration::ZERO,
         }
+    }
+
+    /// Sets this renderer's share of the frame's relighting time.
+    pub fn set_budget(&mut self, budget: Duration) {
+        self.budget = budget;
     }
 
     /// Starts over after an edit: the renderer has restarted its accumulation.
@@ -66,7 +74,7 @@ impl Progressive {
             Some(_) => SAMPLES_PER_BAND.min(target - renderer.row_samples(self.cursor)),
         };
         let wanted = if self.row_seconds > 0.0 {
-            (FRAME_BUDGET.as_secs_f64() / (self.row_seconds * count as f64)) as u32
+            (self.budget.as_secs_f64() / (self.row_seconds * count as f64)) as u32
         } else {
             MIN_BAND_ROWS // the first band measures the device
         };
@@ -90,12 +98,16 @@ impl Progressive {
         Ok(true)
     }
 
-    /// Pixel samples per second while relighting, over the current accumulation.
-    pub fn samples_per_second(&self) -> f64 {
-        if self.busy.is_zero() {
+    /// Pixel samples per second while relighting, over the current accumulation, of this and
+    /// `other` together (an A/B split's two renderers,
+    /// which relight in turn): all their samples over all their relighting time.
+    pub fn samples_per_second_with(&self, other: Option<&Progressive>) -> f64 {
+        let (samples, busy) = other
+            .map_or((self.pixel_samples, self.busy), |b| (self.pixel_samples + b.pixel_samples, self.busy + b.busy));
+        if busy.is_zero() {
             0.0
         } else {
-            self.pixel_samples / self.busy.as_secs_f64()
+            samples / busy.as_secs_f64()
         }
     }
 }

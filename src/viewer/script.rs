@@ -2,7 +2,7 @@
 //! same code as the panels (README: `lookdev view`). The whole file is checked before the window
 //! opens; a line that fails while running stops the viewer with the file and line named.
 
-use super::action::{Action, Answer};
+use super::action::{Action, Answer, Compare};
 use crate::material::params::{parse_value, Param, Value};
 use crate::render::tonemap::Tonemap;
 use crate::viewer_state::{Edit, ObjectRef, Selection};
@@ -60,7 +60,7 @@ impl LayerChange {
 /// The commands, for the error that names an unknown one.
 const COMMANDS: &str = "select, set, reset, add, remove, duplicate, move, show, hide, mask, invert, opacity, \
     rotate, intensity, background, env, exposure, tonemap, spp, seed, undo, redo, pick, wait-spp, save-look, \
-    save-preset, save-image, screenshot, open-look, quit, answer";
+    save-preset, save-image, screenshot, open-look, quit, answer, compare, divider";
 
 impl Script {
     pub fn load(path: &Path) -> Result<Script> {
@@ -267,6 +267,44 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
             };
             Ok(Step::Do(Action::Answer(answer)))
         }
+        "compare" => {
+            let usage = "'compare' takes `model KEY=VALUE...`, `look FILE`, `swap` or `off`";
+            let (what, more) = rest.split_once(char::is_whitespace).unwrap_or((rest, ""));
+            let more = more.trim();
+            let compare = match what {
+                "model" => {
+                    let keys: Vec<String> = more.split_whitespace().map(str::to_string).collect();
+                    if keys.is_empty() {
+                        return Err("'compare model' takes KEY=VALUE changes, e.g. diffuse=lambert".into());
+                    }
+                    // Checked now, so that a bad key is a parse error naming its line.
+                    let mut model = crate::shading::model::Model::default();
+                    for key in &keys {
+                        model.set_from_flag("compare model", key)?;
+                    }
+                    Compare::Model(keys)
+                }
+                "look" if !more.is_empty() => Compare::Look(PathBuf::from(more)),
+                "look" => return Err("'compare look' needs a file".into()),
+                "swap" | "off" if more.is_empty() => {
+                    if what == "swap" {
+                        Compare::Swap
+                    } else {
+                        Compare::Off
+                    }
+                }
+                _ => return Err(usage.into()),
+            };
+            Ok(Step::Do(Action::Compare(compare)))
+        }
+        "divider" => {
+            arity(1)?;
+            let at = float(args[0])?;
+            if !(0.0..=1.0).contains(&at) {
+                return Err(format!("divider {at} is outside [0, 1] (a fraction of the image's width)"));
+            }
+            Ok(Step::Do(Action::Divider(at)))
+        }
         other => Err(format!("unknown command '{other}' (expected one of: {COMMANDS})")),
     }
 }
@@ -331,11 +369,32 @@ mod tests {
             ("wait-spp 0\n", "at least 1 sample"),
             ("background maybe\n", "'maybe' is not on or off"),
             ("undo now\n", "'undo' takes 0 arguments, not 1"),
+            ("compare model diffuse=lamber\n", "compare model diffuse=lamber: diffuse = 'lamber' is not a model"),
+            ("compare model\n", "'compare model' takes KEY=VALUE"),
+            ("compare look\n", "'compare look' needs a file"),
+            ("compare sideways\n", "'compare' takes"),
+            ("divider 1.5\n", "divider 1.5 is outside [0, 1]"),
         ];
         for (text, expected) in cases {
             let message = parse(text).unwrap_err().to_string();
             assert!(message.contains(expected), "{text:?}: {message}");
         }
+    }
+
+    #[test]
+    fn compare_and_divider_parse_to_their_actions() {
+        let script = parse(
+            "compare model diffuse=lambert fresnel=dielectric\ncompare look b.toml\ncompare swap\ncompare off\n\
+             divider 0.25\n",
+        )
+        .unwrap();
+        let steps: Vec<&Step> = script.steps.iter().map(|(_, s)| s).collect();
+        let keys = vec!["diffuse=lambert".to_string(), "fresnel=dielectric".to_string()];
+        assert_eq!(*steps[0], Step::Do(Action::Compare(Compare::Model(keys))));
+        assert_eq!(*steps[1], Step::Do(Action::Compare(Compare::Look(PathBuf::from("b.toml")))));
+        assert_eq!(*steps[2], Step::Do(Action::Compare(Compare::Swap)));
+        assert_eq!(*steps[3], Step::Do(Action::Compare(Compare::Off)));
+        assert_eq!(*steps[4], Step::Do(Action::Divider(0.25)));
     }
 
     #[test]

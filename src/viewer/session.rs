@@ -3,7 +3,8 @@
 //! materials changed, an environment, lighting, seed), so that an edit costs one restart and
 //! an exposure change costs no samples at all.
 
-use super::progressive::Progressive;
+use super::compare::{self, Compare, Subject};
+use super::progressive::{Progressive, FRAME_BUDGET};
 use crate::environment::{self, Environment, LoadOptions};
 use crate::gbuffer::GBuffer;
 use crate::gpu::{Context, Image};
@@ -13,6 +14,7 @@ use crate::render::output::{self, OutputFormat};
 use crate::render::scene::covered_object_ids;
 use crate::render::tonemap::Tonemap;
 use crate::render::{Lighting, Renderer};
+use crate::shading::model::Model;
 use crate::viewer_state::{Document, ObjectRef};
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
@@ -29,6 +31,7 @@ struct Shown {
     seed: u32,
     exposure: f32,
     tonemap: Tonemap,
+    model: Model,
 }
 
 /// Everything known about one pixel, for the inspector.
@@ -97,6 +100,14 @@ pub struct Session {
     pub inspection: Option<Inspection>,
     /// `--exit-after-spp`: the sample count to stop at, whatever the look's target.
     target_override: Option<u32>,
+    /// The A/B split's B side, when comparing.
+    compare: Option<Compare>,
+    /// B sides replaced or turned off this frame: the frame's interface may still draw their
+    /// images, so they go at the next frame's start ([`Session::drop_retired`]).
+    retired: Vec<Compare>,
+    /// Where the split is, as a fraction of the image's width from the left; kept while the
+    /// split is off, so turning it back on finds it where it was.
+    pub divider: f32,
 }
 
 impl Session {
@@ -129,6 +140,7 @@ impl Session {
                 seed: settings.seed,
                 exposure: settings.exposure,
                 tonemap: settings.tonemap,
+                model: settings.model,
             },
             document,
             renderer,
@@ -141,6 +153,9 @@ impl Session {
             first_pass_after_change: None,
             inspection: None,
             target_override: None,
+            compare: None,
+            retired: Vec::new(),
+            divider: 0.5,
         })
     }
 
@@ -167,9 +182,10 @@ impl Session {
         self.gbuffer.height
     }
 
-    /// Samples every pixel has.
+    /// Samples every pixel has (on both sides of a split).
     pub fn samples(&self) -> u32 {
-        self.renderer.samples()
+        let a = self.renderer.samples();
+        self.compare.as_ref().map_or(a, |b| a.min(b.renderer.samples()))
     }
 
     /// Where accumulation stops.
@@ -179,6 +195,115 @@ impl Session {
 
     pub fn display_image(&self) -> &Image {
         self.renderer.display_image()
+    }
+
+    /// B's display image, when comparing.
+    pub fn compare_image(&self) -> Option<&Image> {
+        self.compare.as_ref().map(|b| b.renderer.display_image())
+    }
+
+    /// What B is, when comparing.
+    pub fn compare_subject(&self) -> Option<&Subject> {
+        self.compare.as_ref().map(|b| &b.subject)
+    }
+
+    /// B's progress figures, when comparing.
+    pub fn compare_progressive(&self) -> Option<&Progressive> {
+        self.compare.as_ref().map(|b| &b.progressive)
+    }
+
+    /// The labels of the two halves, "A: …" and "B: …", when comparing.
+    pub fn compare_labels(&self) -> Option<(String, String)> {
+        let b = self.compare.as_ref()?;
+        let a_model = self.document.settings().model;
+        Some(match &b.subject {
+            Subject::Model(model) => (format!("A: {}", a_model.label()), format!("B: {}", model.label())),
+            Subject::Look { path, look } => {
+                let a_name = compare::file_label(self.document.path());
+                let b_model = look.model.unwrap_or_default();
+                let model_part =
+                    |m: Model| if m == Model::default() { String::new() } else { format!(" · {}", m.label()) };
+                (
+                    format!("A: {a_name}{}", model_part(a_model)),
+                    format!("B: {}{}", compare::file_label(Some(path)), model_part(b_model)),
+                )
+            }
+        })
+    }
+
+    /// The image column where B starts, when comparing.
+    pub fn split_column(&self) -> Option<u32> {
+        self.compare.as_ref().map(|_| compare::split_column(self.divider, self.width()))
+    }
+
+    /// Shows B: A's stacks under `model`. Replaces whatever B was.
+    pub fn compare_model(&mut self, model: Model) -> Result<()> {
+        let packed = self.packed.clone();
+        self.start_compare(Subject::Model(model), packed)
+    }
+
+    /// Shows B: the look at `path`, its stacks and model under A's lighting and settings. A look
+    /// that does not load or fit the g-buffer changes nothing.
+    pub fn compare_look(&mut self, path: &Path) -> Result<()> {
+        let look = crate::material::Look::load(path)?;
+        let packed = PackedStacks::pack(&look, self.objects.iter().copied(), &self.masks, &self.gbuffer_name)?;
+        crate::material::stack::unused_stack_warnings(&look, &self.objects, &self.gbuffer_name)
+            .into_iter()
+            .for_each(crate::warn);
+        self.start_compare(Subject::Look { path: path.to_path_buf(), look: Box::new(look) }, packed)
+    }
+
+    fn start_compare(&mut self, subject: Subject, packed: PackedStacks) -> Result<()> {
+        let settings = self.document.settings().clone();
+        let environment = self
+            .environments
+            .iter()
+            .find(|(p, _)| *p == self.shown.environment)
+            .map(|(_, e)| e)
+            .ok_or_else(|| Error::gpu("the environment on screen is not loaded"))?;
+        let mut renderer = Renderer::with_model(&self.ctx, &self.gbuffer, environment, &subject.model())?;
+        renderer.set_stacks(&packed)?;
+        renderer.set_lighting(self.shown.lighting);
+        renderer.set_seed(self.shown.seed);
+        renderer.finalize_rows(0, self.height(), settings.exposure, settings.tonemap)?;
+        let mut progressive = Progressive::new();
+        progressive.set_budget(FRAME_BUDGET / 2);
+        self.progressive.set_budget(FRAME_BUDGET / 2);
+        self.retired.extend(self.compare.replace(Compare { subject, renderer, progressive, packed }));
+        Ok(())
+    }
+
+    /// Back to the plain image: B's renderer goes and A has the whole frame budget.
+    pub fn compare_off(&mut self) {
+        self.retired.extend(self.compare.take());
+        self.progressive.set_budget(FRAME_BUDGET);
+    }
+
+    /// Lets go of B sides that were replaced or turned off, once the GPU is done with them.
+    pub fn drop_retired(&mut self) -> Result<()> {
+        if !self.retired.is_empty() {
+            unsafe { self.ctx.device.device_wait_idle() }?;
+            self.retired.clear();
+        }
+        Ok(())
+    }
+
+    /// Swaps the halves of a model comparison: A's look takes B's model (an undoable edit) and B
+    /// shows A's old one. Each side keeps its samples: the renderers swap too.
+    pub fn swap_models(&mut self) -> Result<()> {
+        let Some(b) = &mut self.compare else {
+            return Err(Error::input("swap: nothing is being compared"));
+        };
+        let Subject::Model(b_model) = b.subject else {
+            return Err(Error::input("swap: B is a look, not a model"));
+        };
+        let a_model = self.document.settings().model;
+        self.document.apply(crate::viewer_state::Edit::SetModel(b_model)).map_err(Error::input)?;
+        b.subject = Subject::Model(a_model);
+        std::mem::swap(&mut self.renderer, &mut b.renderer);
+        std::mem::swap(&mut self.progressive, &mut b.progressive);
+        self.shown.model = b_model;
+        Ok(())
     }
 
     pub fn device_name(&self) -> &str {
@@ -228,6 +353,11 @@ impl Session {
             )?;
             if everything || packed != self.packed {
                 self.renderer.set_stacks(&packed)?;
+                if let Some(b) = self.compare.as_mut().filter(|b| matches!(b.subject, Subject::Model(_))) {
+                    b.renderer.set_stacks(&packed)?;
+                    b.packed = packed.clone();
+                    b.progressive.restart();
+                }
                 self.packed = packed;
                 restarted = true;
             }
@@ -237,14 +367,28 @@ impl Session {
             self.load_environment(settings.environment.as_deref())?;
             let (_, environment) = self.environments.last().expect("just loaded");
             self.renderer.set_environment(environment)?;
+            if let Some(b) = &mut self.compare {
+                b.renderer.set_environment(environment)?;
+                b.progressive.restart();
+            }
             self.shown.environment = settings.environment.clone();
             restarted = true;
         }
         if everything || settings.lighting != self.shown.lighting || settings.seed != self.shown.seed {
             self.renderer.set_lighting(settings.lighting);
             self.renderer.set_seed(settings.seed);
+            if let Some(b) = &mut self.compare {
+                b.renderer.set_lighting(settings.lighting);
+                b.renderer.set_seed(settings.seed);
+                b.progressive.restart();
+            }
             self.shown.lighting = settings.lighting;
             self.shown.seed = settings.seed;
+            restarted = true;
+        }
+        if everything || settings.model != self.shown.model {
+            self.renderer.set_model(&settings.model)?;
+            self.shown.model = settings.model;
             restarted = true;
         }
         if restarted {
@@ -257,6 +401,9 @@ impl Session {
             self.shown.tonemap = settings.tonemap;
             // The same samples, shown anew: nothing restarts.
             self.renderer.finalize_rows(0, self.height(), settings.exposure, settings.tonemap)?;
+            if let Some(b) = &self.compare {
+                b.renderer.finalize_rows(0, self.height(), settings.exposure, settings.tonemap)?;
+            }
         }
         Ok(())
     }
@@ -266,8 +413,11 @@ impl Session {
         let target = self.target();
         let settings = self.document.settings();
         let (exposure, tonemap) = (settings.exposure, settings.tonemap);
-        let stepped = self.progressive.step(&mut self.renderer, target, exposure, tonemap)?;
-        if self.first_pass_after_change.is_none() && self.renderer.samples() > 0 {
+        let mut stepped = self.progressive.step(&mut self.renderer, target, exposure, tonemap)?;
+        if let Some(b) = &mut self.compare {
+            stepped |= b.progressive.step(&mut b.renderer, target, exposure, tonemap)?;
+        }
+        if self.first_pass_after_change.is_none() && self.samples() > 0 {
             self.first_pass_after_change = Some(self.changed_at.elapsed());
         }
         Ok(stepped)

@@ -9,6 +9,7 @@ use crate::material::params::{Param, Params, Value};
 use crate::render::settings::{Settings, DEFAULT_SPP, MAX_EXPOSURE};
 use crate::render::tonemap::Tonemap;
 use crate::render::Lighting;
+use crate::shading::model::Model;
 
 /// Which layer stack an edit is aimed at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -129,6 +130,8 @@ pub enum Edit {
     /// The samples per pixel accumulation stops at; at least 1.
     SetTargetSpp(u32),
     SetSeed(u32),
+    /// The BRDF model (the look's `[model]` table).
+    SetModel(Model),
 }
 
 /// What makes two edits parts of one gesture, such as a slider drag: the same kind of edit on the
@@ -289,6 +292,7 @@ impl State {
                 next.settings.spp = spp;
             }
             Edit::SetSeed(seed) => next.settings.seed = seed,
+            Edit::SetModel(model) => next.settings.model = model,
         }
         next.mirror_settings(saved);
         Ok(next)
@@ -336,6 +340,7 @@ impl State {
             exposure: keep(render.exposure, s.exposure, 0.0),
             tonemap: keep(render.tonemap, s.tonemap, Tonemap::default()),
         };
+        self.look.model = keep(saved.model, s.model, Model::default());
     }
 }
 

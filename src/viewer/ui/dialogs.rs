@@ -13,6 +13,8 @@ pub enum FilePurpose {
     SaveLook,
     SaveImage,
     OpenEnvironment,
+    /// A look to show as B in the A/B split.
+    CompareLook,
 }
 
 impl FilePurpose {
@@ -22,13 +24,14 @@ impl FilePurpose {
             FilePurpose::SaveLook => "Save look as",
             FilePurpose::SaveImage => "Save image",
             FilePurpose::OpenEnvironment => "Open environment",
+            FilePurpose::CompareLook => "Compare with look",
         }
     }
 
     /// The extensions listed, the first being what a bare name gets when saving.
     fn extensions(self) -> &'static [&'static str] {
         match self {
-            FilePurpose::OpenLook | FilePurpose::SaveLook => &["toml"],
+            FilePurpose::OpenLook | FilePurpose::SaveLook | FilePurpose::CompareLook => &["toml"],
             FilePurpose::SaveImage => &["png", "exr"],
             FilePurpose::OpenEnvironment => &["exr", "hdr"],
         }
@@ -44,6 +47,7 @@ impl FilePurpose {
             FilePurpose::SaveLook => Action::SaveLook(Some(path)),
             FilePurpose::SaveImage => Action::SaveImage(path),
             FilePurpose::OpenEnvironment => Action::OpenEnvironment(Some(path)),
+            FilePurpose::CompareLook => Action::Compare(super::super::action::Compare::Look(path)),
         }
     }
 }

@@ -6,6 +6,7 @@
 //! library, file choosing, saving a preset and the unsaved-edits question.
 
 mod browser;
+mod compare;
 mod dialogs;
 mod inspector;
 mod layers;
@@ -49,6 +50,8 @@ pub struct FrameFigures {
 pub struct Frame<'a> {
     pub session: &'a Session,
     pub view_texture: egui::TextureId,
+    /// B's rendered view, while comparing.
+    pub compare_texture: Option<egui::TextureId>,
     pub pending: Option<&'a Pending>,
     pub figures: FrameFigures,
 }
@@ -93,11 +96,14 @@ impl Interface {
             egui::ScrollArea::vertical().show(ui, |ui| {
                 lighting::show(ui, frame.session, &mut self.file_dialog, actions);
                 ui.separator();
+                compare::show(ui, frame.session, &mut self.file_dialog, actions);
+                ui.separator();
                 inspector::show(ui, frame.session);
             })
         });
         egui::CentralPanel::no_frame().show(ui, |ui| {
-            self.placement = Some(self.viewport.show(ui, frame.session, frame.view_texture, actions));
+            self.placement =
+                Some(self.viewport.show(ui, frame.session, frame.view_texture, frame.compare_texture, actions));
         });
         let ctx = ui.ctx().clone();
         self.browser.show(&ctx, frame.session, thumbnails, actions, &mut self.message);
@@ -224,7 +230,8 @@ impl Interface {
             let state = if samples >= target { "done" } else { "rendering" };
             ui.label(format!("{samples} / {target} spp ({state})"));
             ui.separator();
-            ui.label(format!("{:.1} M samples/s", session.progressive.samples_per_second() / 1e6));
+            let rate = session.progressive.samples_per_second_with(session.compare_progressive());
+            ui.label(format!("{:.1} M samples/s", rate / 1e6));
             ui.separator();
             ui.label(format!("frame {:.1} ms", frame.figures.frame.as_secs_f64() * 1e3));
             if let Some(first) = session.first_pass_after_change {

@@ -20,7 +20,12 @@ pub struct Viewport {
     pan: egui::Vec2,
     /// A Shift+drag in progress: the rotation it started from and the distance dragged.
     rotating: Option<(f32, f32)>,
+    /// The A/B split's divider is being dragged.
+    dividing: bool,
 }
+
+/// How near the divider (in points) a drag grabs it rather than panning.
+const DIVIDER_GRAB: f32 = 6.0;
 
 /// Where the image was drawn, in window pixels, for the screenshot report.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -49,6 +54,7 @@ impl Viewport {
         ui: &mut egui::Ui,
         session: &Session,
         texture: egui::TextureId,
+        compare: Option<egui::TextureId>,
         actions: &mut Vec<Action>,
     ) -> ImagePlacement {
         let rect = ui.max_rect();
@@ -65,10 +71,30 @@ impl Viewport {
 
         let painter = ui.painter_at(rect);
         painter.rect_filled(rect, 0.0, Color32::from_gray(18));
-        painter.image(texture, image_rect, Rect::from_min_max(pos2(0.0, 0.0), pos2(1.0, 1.0)), Color32::WHITE);
+        let split = compare.zip(session.split_column());
+        match split {
+            None => {
+                painter.image(texture, image_rect, Rect::from_min_max(pos2(0.0, 0.0), pos2(1.0, 1.0)), Color32::WHITE);
+            }
+            Some((b, column)) => {
+                // Both images cover the whole frame; each half shows its own part, so dragging
+                // the divider costs no rendering.
+                let u = column as f32 / w;
+                let x = image_rect.min.x + image_rect.width() * u;
+                let a_rect = Rect::from_min_max(image_rect.min, pos2(x, image_rect.max.y));
+                let b_rect = Rect::from_min_max(pos2(x, image_rect.min.y), image_rect.max);
+                painter.image(texture, a_rect, Rect::from_min_max(pos2(0.0, 0.0), pos2(u, 1.0)), Color32::WHITE);
+                painter.image(b, b_rect, Rect::from_min_max(pos2(u, 0.0), pos2(1.0, 1.0)), Color32::WHITE);
+            }
+        }
 
         let rotation = session.document.settings().lighting.rotation_degrees;
-        self.interact(ui, &response, rotation, scale, actions);
+        if let Some((_, column)) = split {
+            self.drag_divider(ui, &response, image_rect, column as f32 / w, actions);
+        }
+        if !self.dividing {
+            self.interact(ui, &response, rotation, scale, actions);
+        }
         self.zoom(ui, &response, rect, centre, scale);
         if response.clicked() {
             if let Some(pixel) = response.interact_pointer_pos().and_then(|p| pixel_at(p, image_rect, w, h)) {
@@ -76,6 +102,9 @@ impl Viewport {
             }
         }
         self.overlay(ui, &response, &painter, rect, image_rect, scale, (w, h), rotation);
+        if let (Some((_, column)), Some(labels)) = (split, session.compare_labels()) {
+            split_overlay(&painter, image_rect, image_rect.min.x + image_rect.width() * column as f32 / w, labels);
+        }
         ImagePlacement {
             x: (image_rect.min.x * ppp).round() as i32,
             y: (image_rect.min.y * ppp).round() as i32,
@@ -110,6 +139,36 @@ impl Viewport {
             // Panning a fitted image keeps its size: fit becomes an explicit zoom.
             self.scale = Some(scale);
             self.pan += response.drag_delta();
+        }
+    }
+
+    /// A drag that starts on the divider moves it (a fraction of the image's width).
+    fn drag_divider(
+        &mut self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        image_rect: Rect,
+        at: f32,
+        actions: &mut Vec<Action>,
+    ) {
+        let x = image_rect.min.x + image_rect.width() * at;
+        let shift = ui.input(|i| i.modifiers.shift);
+        if response.drag_started_by(PointerButton::Primary) && !shift {
+            let start = ui.input(|i| i.pointer.press_origin());
+            self.dividing =
+                start.is_some_and(|p| (p.x - x).abs() <= DIVIDER_GRAB && image_rect.y_range().contains(p.y));
+        }
+        if self.dividing {
+            if let Some(p) = response.interact_pointer_pos().filter(|_| response.dragged()) {
+                let fraction = ((p.x - image_rect.min.x) / image_rect.width()).clamp(0.0, 1.0);
+                actions.push(Action::Divider(fraction));
+            }
+            if response.drag_stopped() || !response.dragged() {
+                self.dividing = false;
+            }
+        }
+        if response.hover_pos().is_some_and(|p| (p.x - x).abs() <= DIVIDER_GRAB) || self.dividing {
+            ui.ctx().set_cursor_icon(egui::CursorIcon::ResizeHorizontal);
         }
     }
 
@@ -169,6 +228,25 @@ impl Viewport {
             );
         }
     }
+}
+
+/// The divider line and the halves' labels, "A: …" top left and "B: …" top right, each on a dark
+/// plate so that it reads over any image.
+fn split_overlay(painter: &egui::Painter, image_rect: Rect, x: f32, (a, b): (String, String)) {
+    painter.line_segment(
+        [pos2(x, image_rect.min.y), pos2(x, image_rect.max.y)],
+        egui::Stroke::new(1.0, Color32::from_rgba_unmultiplied(255, 255, 255, 200)),
+    );
+    let font = egui::FontId::proportional(12.0);
+    let margin = vec2(4.0, 3.0);
+    let plate = |text: String, anchor: egui::Pos2, align: egui::Align2| {
+        let galley = painter.layout_no_wrap(text, font.clone(), Color32::WHITE);
+        let rect = align.anchor_size(anchor, galley.size() + margin * 2.0);
+        painter.rect_filled(rect, 2.0, Color32::from_black_alpha(170));
+        painter.galley(rect.min + margin, galley, Color32::WHITE);
+    };
+    plate(a, pos2(x - 2.0, image_rect.min.y + 2.0), egui::Align2::RIGHT_TOP);
+    plate(b, pos2(x + 2.0, image_rect.min.y + 2.0), egui::Align2::LEFT_TOP);
 }
 
 /// The image pixel under window point `p`, if it is on the image.
