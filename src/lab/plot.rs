@@ -113,8 +113,8 @@ fn register_font() {
 fn legend_width(labels: &[&str]) -> u32 {
     let labeller = sheet::Labeller::default();
     let text = labels.iter().map(|l| labeller.width(l, TEXT_SIZE as f32)).fold(0.0, f32::max);
-    // A gap from the axes, the frame's padding, the line sample and the space after it.
-    text.ceil() as u32 + 12 + 2 * 10 + 24 + 8
+    // Margins of 12 either side, the frame's padding of 10, the line sample and the space after it.
+    text.ceil() as u32 + 2 * 12 + 2 * 10 + 24 + 8
 }
 
 /// A legend at the top-left corner of `area`, `top` pixels down: a line sample in each entry's
@@ -125,7 +125,7 @@ fn draw_legend<DB: DrawingBackend>(
     entries: &[(&str, RGBColor)],
 ) -> std::result::Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let labels: Vec<&str> = entries.iter().map(|e| e.0).collect();
-    let (left, right) = (12, legend_width(&labels) as i32);
+    let (left, right) = (12, legend_width(&labels) as i32 - 12);
     let row = TEXT_SIZE as i32 + 8;
     let bottom = top + 2 * 6 + row * entries.len() as i32;
     area.draw(&Rectangle::new([(left, top), (right, bottom)], BLACK.mix(0.3).stroke_width(1)))?;
