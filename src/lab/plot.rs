@@ -198,16 +198,15 @@ fn ring_step(top: f32, count: f32) -> f32 {
     [1.0, 2.0, 2.5, 5.0, 10.0].into_iter().map(|m| m * power).find(|s| *s >= raw).unwrap_or(10.0 * power)
 }
 
+type PolarAxes = Cartesian2d<RangedCoordf32, RangedCoordf32>;
+
 /// The polar plot's axes, x from −`half_width` to `half_width` and y from 0 to `height`.
 fn polar_chart<'a, DB: DrawingBackend>(
     root: &'a DrawingArea<DB, Shift>,
     title: &str,
     half_width: f32,
     height: f32,
-) -> std::result::Result<
-    ChartContext<'a, DB, Cartesian2d<RangedCoordf32, RangedCoordf32>>,
-    DrawingAreaErrorKind<DB::ErrorType>,
-> {
+) -> std::result::Result<ChartContext<'a, DB, PolarAxes>, DrawingAreaErrorKind<DB::ErrorType>> {
     ChartBuilder::on(root)
         .caption(title, (FONT, TITLE_SIZE))
         .margin(12)
@@ -359,8 +358,10 @@ mod tests {
         &tag[start..start + tag[start..].find('"').unwrap()]
     }
 
-    /// Each `<polyline>`: its stroke colour, stroke width and points.
-    fn polylines(svg: &str) -> Vec<(String, String, Vec<(f32, f32)>)> {
+    /// A `<polyline>`'s stroke colour, stroke width and points.
+    type Polyline = (String, String, Vec<(f32, f32)>);
+
+    fn polylines(svg: &str) -> Vec<Polyline> {
         svg.split("<polyline")
             .skip(1)
             .map(|rest| {
