@@ -38,6 +38,43 @@ fn csv(path: &Path) -> Vec<(String, Vec<f32>)> {
         .collect()
 }
 
+/// The subjects of a CSV's rows, in order, each once.
+fn subjects(rows: &[(String, Vec<f32>)]) -> Vec<String> {
+    let mut labels: Vec<String> = Vec::new();
+    for (label, _) in rows {
+        if !labels.contains(label) {
+            labels.push(label.clone());
+        }
+    }
+    labels
+}
+
+/// A line plot is an SVG document with one curve per subject (a 2-pixel polyline through every
+/// one of its `points`), each subject's label as legend text, and the title.
+fn assert_plot(path: &Path, title: &str, labels: &[String], points: usize) {
+    let svg = std::fs::read_to_string(path).unwrap();
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"), "{}", path.display());
+    let curves = svg
+        .split("<polyline")
+        .skip(1)
+        .map(|rest| &rest[..rest.find("/>").unwrap()])
+        .filter(|tag| tag.contains(r#" stroke-width="2""#))
+        .filter(|tag| {
+            let start = tag.find(r#" points=""#).unwrap() + 9;
+            tag[start..start + tag[start..].find('"').unwrap()].split_whitespace().count() == points
+        })
+        .count();
+    assert_eq!(curves, labels.len(), "{}: curves", path.display());
+    let texts: Vec<String> = svg
+        .split("<text")
+        .skip(1)
+        .map(|rest| rest[rest.find('>').unwrap() + 1..rest.find("</text>").unwrap()].trim().replace("&amp;", "&"))
+        .collect();
+    for text in labels.iter().map(String::as_str).chain([title]) {
+        assert!(texts.iter().any(|t| t == text), "{}: {text:?} not among {texts:?}", path.display());
+    }
+}
+
 fn subject(preset: &str, text: &str) -> Subject {
     let mut model = Model::default();
     for part in text.split(',').filter(|p| !p.is_empty()) {
@@ -63,10 +100,11 @@ fn albedo_and_polar_csvs_are_the_integrator_and_the_reference() {
         "--out",
         out.to_str().unwrap(),
     ]);
-    let svg = std::fs::read_to_string(&out).unwrap();
-    assert!(svg.starts_with("<svg") && svg.matches("<polyline").count() == 4, "four curves");
     let rows = csv(&dir.path().join("albedo.csv"));
     assert_eq!(rows.len(), 4 * 45);
+    let labels = subjects(&rows);
+    assert_eq!(labels.len(), 4);
+    assert_plot(&out, "Directional albedo", &labels, 45);
     for (label, values) in rows.iter().step_by(7) {
         let preset = if label.starts_with("gold") { "gold" } else { "red-plastic" };
         let model = if label.contains("oren-nayar") { "diffuse=oren-nayar,specular_d=beckmann" } else { "" };
@@ -102,6 +140,7 @@ fn albedo_and_polar_csvs_are_the_integrator_and_the_reference() {
     ]);
     let rows = csv(&dir.path().join("polar.csv"));
     assert_eq!(rows.len(), 179);
+    assert_plot(&out, "In-plane lobe, θi = 30°", &subjects(&rows), 179);
     let s = subject("gold", "fresnel=conductor");
     let l = in_plane(-30f32.to_radians());
     let mut peak = (0.0f32, 0.0f32);

@@ -157,6 +157,10 @@ fn check_extension(out: &Path, wanted: &str, flag: &str) -> Result<()> {
     }
 }
 
+fn drawing_failed(out: &Path, error: plot::DrawError) -> Error {
+    Error::io(out, format!("drawing the plot failed: {error}"))
+}
+
 pub fn run(args: BrdfArgs) -> Result<()> {
     match args.plot {
         PlotKind::Slice { subjects, phi_d, out } => {
@@ -193,7 +197,8 @@ pub fn run(args: BrdfArgs) -> Result<()> {
                 &labels,
                 &angles,
                 &ys,
-            );
+            )
+            .map_err(|e| drawing_failed(&out, e))?;
             plot::write_plot(&out, PlotFile::Svg(svg), &plot::curves_csv("theta_v", &subjects, &angles, &data))?;
         }
         PlotKind::Polar { subjects, theta_i, out } => {
@@ -206,7 +211,8 @@ pub fn run(args: BrdfArgs) -> Result<()> {
             let data = plot::polar_data(&subjects, theta_i, &angles);
             let labels: Vec<String> = subjects.iter().map(|s| s.label.clone()).collect();
             let values: Vec<Vec<f32>> = data.iter().map(|d| d.iter().map(|v| luminance(*v)).collect()).collect();
-            let svg = plot::polar_svg(&format!("In-plane lobe, θi = {theta_i}°"), &labels, &angles, &values, theta_i);
+            let svg = plot::polar_svg(&format!("In-plane lobe, θi = {theta_i}°"), &labels, &angles, &values, theta_i)
+                .map_err(|e| drawing_failed(&out, e))?;
             plot::write_plot(&out, PlotFile::Svg(svg), &plot::curves_csv("theta_o", &subjects, &angles, &data))?;
         }
         PlotKind::Furnace { subjects, columns, metallic, size, spp, device, out } => {
