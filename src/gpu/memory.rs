@@ -371,15 +371,7 @@ impl Image {
 
     /// Records a copy of the whole image into `staging` (which must be large enough).
     pub fn record_read(&self, cmd: vk::CommandBuffer, staging: &Buffer) {
-        unsafe {
-            self.shared.device.cmd_copy_image_to_buffer(
-                cmd,
-                self.image,
-                vk::ImageLayout::GENERAL,
-                staging.buffer,
-                &[self.copy_region()],
-            )
-        };
+        self.record_read_at(cmd, staging, 0);
     }
 
     /// Records a copy of the whole image into `staging` from byte `offset` on.
