@@ -216,6 +216,36 @@ fn wedge_matches_its_golden_image() {
 }
 
 #[test]
+fn wedges_and_sheets_render_the_model_they_are_given() {
+    let s = Setup::new();
+    s.write("library/model-test.toml", &preset(0.8, "\"model-test\""));
+    let render = |command: &[&str], name: &str, model: Option<&str>| {
+        let out = s.arg(name);
+        let mut args: Vec<&str> = command.to_vec();
+        args.extend(["--size", "32", "--spp", "4", "--quiet", "--out", &out]);
+        if let Some(model) = model {
+            args.extend(["--model", model]);
+        }
+        ok(s.run(&args));
+        image::open(&out).unwrap().to_rgba8()
+    };
+    let wedge = ["wedge", "--param", "roughness", "--values", "0.3,0.9"];
+    let sheet = ["presets", "sheet", "--tag", "model-test"];
+    for (command, name) in [(&wedge[..], "wedge"), (&sheet[..], "sheet")] {
+        let plain = render(command, &format!("{name}.png"), None);
+        let oren_nayar = render(command, &format!("{name}-on.png"), Some("diffuse=oren-nayar"));
+        assert_eq!(plain.dimensions(), oren_nayar.dimensions());
+        assert_ne!(plain, oren_nayar, "{name}: --model changes the renders");
+        let again = render(command, &format!("{name}-default.png"), Some("diffuse=burley2012"));
+        assert_eq!(plain, again, "{name}: the default model, named, is the default render");
+    }
+    let out = s.arg("bad.png");
+    let bad = s.run(&["wedge", "--param", "roughness", "--model", "diffuse=velvet", "--out", &out]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("velvet"));
+}
+
+#[test]
 fn turntable_frames_are_independent_of_how_the_range_is_split() {
     let s = Setup::new();
     let g = s.arg("g.exr");

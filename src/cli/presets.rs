@@ -76,6 +76,9 @@ pub struct SheetArgs {
     pub display: DisplayArgs,
     #[arg(long, default_value_t = 128)]
     pub spp: u32,
+    /// Choose a BRDF model variant over the look's [model], as render's --model (repeatable).
+    #[arg(long = "model", value_name = "KEY=VALUE")]
+    pub model: Vec<String>,
     /// Side of each render in pixels.
     #[arg(long, default_value_t = 192)]
     pub size: u32,
@@ -223,7 +226,7 @@ fn sheet(args: SheetArgs) -> Result<()> {
     if args.lighting.env.is_some() {
         base.environment = Default::default();
     }
-    let sampling = SamplingArgs { spp: Some(args.spp), ..SamplingArgs::default() };
+    let sampling = SamplingArgs { spp: Some(args.spp), model: args.model.clone(), ..SamplingArgs::default() };
     let settings = Settings::resolve(&base, &inputs::overrides(&args.lighting, &sampling, &args.display))?;
     let environment = match &settings.environment {
         Some(path) => environment::load::load(path, &args.lighting.load_options())?,

@@ -32,6 +32,9 @@ pub struct WedgeArgs {
     pub display: DisplayArgs,
     #[arg(long, default_value_t = 64)]
     pub spp: u32,
+    /// Choose a BRDF model variant over the look's [model], as render's --model (repeatable).
+    #[arg(long = "model", value_name = "KEY=VALUE")]
+    pub model: Vec<String>,
     /// Side of each render in pixels.
     #[arg(long, default_value_t = 128)]
     pub size: u32,
@@ -97,7 +100,7 @@ pub fn run(args: WedgeArgs) -> Result<()> {
         None if args.lighting.env.is_some() => Look { environment: Default::default(), ..default_look() },
         None => default_look(),
     };
-    let sampling = SamplingArgs { spp: Some(args.spp), ..SamplingArgs::default() };
+    let sampling = SamplingArgs { spp: Some(args.spp), model: args.model.clone(), ..SamplingArgs::default() };
     let settings = Settings::resolve(&look, &inputs::overrides(&args.lighting, &sampling, &args.display))?;
     let environment = match &settings.environment {
         Some(path) => environment::load::load(path, &args.lighting.load_options())?,
