@@ -68,16 +68,7 @@ impl Import {
             let axes = &imported.mapped.axes;
             // The corner of the axes' box where the axes in `corner` are at their end.
             let layer = |mask: Option<String>, corner: usize| {
-                let mut layer = Layer {
-                    preset: Some(reference.clone()),
-                    params,
-                    overrides: Vec::new(),
-                    mask,
-                    invert: false,
-                    opacity: 1.0,
-                    enabled: true,
-                    line: 0,
-                };
+                let mut layer = Layer { preset: Some(reference.clone()), mask, ..Layer::filling(params) };
                 for (i, axis) in axes.iter().enumerate() {
                     axis.apply(&mut layer.params, corner & (1 << i) != 0);
                     layer.overrides.push(match axis {

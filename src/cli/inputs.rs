@@ -1,8 +1,9 @@
 //! The flags every rendering command shares: lighting, sampling, display, and `--set`.
 
-use crate::environment::LoadOptions;
-use crate::material::{Param, Value};
-use crate::render::settings::Overrides;
+use crate::environment::{self, Environment, LoadOptions};
+use crate::gbuffer::GBuffer;
+use crate::material::{Look, Param, Value};
+use crate::render::settings::{Overrides, Settings};
 use crate::render::tonemap::Tonemap;
 use crate::Result;
 use clap::Args;
@@ -84,4 +85,23 @@ pub fn overrides(lighting: &LightingArgs, sampling: &SamplingArgs, display: &Dis
 /// Parses every `--set NAME=VALUE`.
 pub fn parse_sets(texts: &[String]) -> Result<Vec<(Param, Value)>> {
     texts.iter().map(|t| super::parse_set(t)).collect()
+}
+
+/// What `presets sheet` and `wedge` render with: the settings of `look` under the flags, `spp`
+/// and `model`, its environment, and the built-in shader ball `size` pixels square.
+pub fn ball_inputs(
+    look: &Look,
+    lighting: &LightingArgs,
+    display: &DisplayArgs,
+    spp: u32,
+    model: &[String],
+    size: u32,
+) -> Result<(Settings, Environment, GBuffer)> {
+    let sampling = SamplingArgs { spp: Some(spp), model: model.to_vec(), ..SamplingArgs::default() };
+    let settings = Settings::resolve(look, &overrides(lighting, &sampling, display))?;
+    let environment = match &settings.environment {
+        Some(path) => environment::load::load(path, &lighting.load_options())?,
+        None => Environment::studio(),
+    };
+    Ok((settings, environment, GBuffer::shaderball(size, size)))
 }

@@ -1,15 +1,12 @@
 //! `lookdev presets list | show | save | sheet`: the preset library.
 
-use super::inputs::{self, DisplayArgs, LightingArgs, SamplingArgs};
+use super::inputs::{self, DisplayArgs, LightingArgs};
 use super::progress::Progress;
-use crate::environment::{self, Environment};
-use crate::gbuffer::GBuffer;
 use crate::material::library::{self, Library, Origin};
 use crate::material::look::{Layer, Look};
 use crate::material::params::{Param, Params};
 use crate::material::Preset;
 use crate::render::batch::{preset_on_ball, Batch};
-use crate::render::settings::Settings;
 use crate::render::sheet::{self, Cell};
 use crate::{Error, Result};
 use clap::{Args, Subcommand};
@@ -226,13 +223,8 @@ fn sheet(args: SheetArgs) -> Result<()> {
     if args.lighting.env.is_some() {
         base.environment = Default::default();
     }
-    let sampling = SamplingArgs { spp: Some(args.spp), model: args.model.clone(), ..SamplingArgs::default() };
-    let settings = Settings::resolve(&base, &inputs::overrides(&args.lighting, &sampling, &args.display))?;
-    let environment = match &settings.environment {
-        Some(path) => environment::load::load(path, &args.lighting.load_options())?,
-        None => Environment::studio(),
-    };
-    let gbuffer = GBuffer::shaderball(args.size, args.size);
+    let (settings, environment, gbuffer) =
+        inputs::ball_inputs(&base, &args.lighting, &args.display, args.spp, &args.model, args.size)?;
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
     let cells = {

@@ -1,14 +1,11 @@
 //! `lookdev wedge`: a look rendered once per value of a parameter, in labelled rows; with
 //! `--param all`, one row per parameter, as in figure 16 of Burley's 2012 notes.
 
-use super::inputs::{self, DisplayArgs, LightingArgs, SamplingArgs};
+use super::inputs::{self, DisplayArgs, LightingArgs};
 use super::progress::Progress;
-use crate::environment::{self, Environment};
-use crate::gbuffer::GBuffer;
 use crate::material::params::{check, Param, Value};
 use crate::material::Look;
 use crate::render::batch::Batch;
-use crate::render::settings::Settings;
 use crate::render::sheet;
 use crate::{Error, Result};
 use clap::Args;
@@ -100,13 +97,8 @@ pub fn run(args: WedgeArgs) -> Result<()> {
         None if args.lighting.env.is_some() => Look { environment: Default::default(), ..default_look() },
         None => default_look(),
     };
-    let sampling = SamplingArgs { spp: Some(args.spp), model: args.model.clone(), ..SamplingArgs::default() };
-    let settings = Settings::resolve(&look, &inputs::overrides(&args.lighting, &sampling, &args.display))?;
-    let environment = match &settings.environment {
-        Some(path) => environment::load::load(path, &args.lighting.load_options())?,
-        None => Environment::studio(),
-    };
-    let gbuffer = GBuffer::shaderball(args.size, args.size);
+    let (settings, environment, gbuffer) =
+        inputs::ball_inputs(&look, &args.lighting, &args.display, args.spp, &args.model, args.size)?;
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
     let rows = {

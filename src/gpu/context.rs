@@ -255,7 +255,7 @@ pub fn full_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
 }
 
 /// Makes everything written so far visible to host reads once the submission completes.
-fn host_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
+pub fn host_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
     let barrier = vk::MemoryBarrier::default()
         .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
         .dst_access_mask(vk::AccessFlags::HOST_READ);

@@ -119,6 +119,23 @@ pub struct Layer {
     pub line: usize,
 }
 
+impl Layer {
+    /// A layer of these parameters with no preset, mask or overrides, at full opacity: what fills
+    /// a stack on its own.
+    pub fn filling(params: Params) -> Layer {
+        Layer {
+            preset: None,
+            params,
+            overrides: Vec::new(),
+            mask: None,
+            invert: false,
+            opacity: 1.0,
+            enabled: true,
+            line: 0,
+        }
+    }
+}
+
 /// Layers are equal when they mean the same. `line` records where one was written, not what
 /// it means, so it is left out: that is what lets `parse(to_toml(look)) == look` hold.
 impl PartialEq for Layer {
@@ -180,17 +197,7 @@ impl Look {
         if self.objects.iter().any(|o| o.id.is_none()) {
             return false;
         }
-        let layer = Layer {
-            preset: None,
-            params: Params::default(),
-            overrides: Vec::new(),
-            mask: None,
-            invert: false,
-            opacity: 1.0,
-            enabled: true,
-            line: 0,
-        };
-        self.objects.push(ObjectStack { id: None, layers: vec![layer] });
+        self.objects.push(ObjectStack { id: None, layers: vec![Layer::filling(Params::default())] });
         true
     }
 

@@ -66,21 +66,11 @@ impl<'a> Batch<'a> {
 /// The look of a preset's catalogue picture (a contact-sheet cell, a viewer thumbnail): the
 /// preset on the ball, a neutral mid-grey pedestal.
 pub fn preset_on_ball(params: &Params) -> Look {
-    let layer = |params: Params| Layer {
-        preset: None,
-        params,
-        overrides: Vec::new(),
-        mask: None,
-        invert: false,
-        opacity: 1.0,
-        enabled: true,
-        line: 0,
-    };
     let pedestal = Params { base_color: [0.18; 3], roughness: 0.6, ..Params::default() };
     let mut look = Look::default_material();
     look.objects = vec![
-        ObjectStack { id: None, layers: vec![layer(pedestal)] },
-        ObjectStack { id: Some(crate::gbuffer::BALL_ID), layers: vec![layer(*params)] },
+        ObjectStack { id: None, layers: vec![Layer::filling(pedestal)] },
+        ObjectStack { id: Some(crate::gbuffer::BALL_ID), layers: vec![Layer::filling(*params)] },
     ];
     look
 }

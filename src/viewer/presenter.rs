@@ -1,7 +1,7 @@
 //! Presenting frames to the window: the swapchain, one frame in flight, and capturing the
 //! window's contents for screenshots.
 
-use crate::gpu::context::full_barrier;
+use crate::gpu::context::{full_barrier, host_barrier};
 use crate::gpu::{Buffer, Context};
 use crate::{Error, Result};
 use ash::vk;
@@ -257,18 +257,7 @@ impl Presenter {
                     vk::ImageLayout::PRESENT_SRC_KHR,
                 ),
             }
-            let host = vk::MemoryBarrier::default()
-                .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
-                .dst_access_mask(vk::AccessFlags::HOST_READ);
-            device.cmd_pipeline_barrier(
-                cmd,
-                vk::PipelineStageFlags::ALL_COMMANDS,
-                vk::PipelineStageFlags::HOST,
-                vk::DependencyFlags::empty(),
-                &[host],
-                &[],
-                &[],
-            );
+            host_barrier(&device, cmd);
             device.end_command_buffer(cmd)?;
         }
         let waits = [self.image_available];

@@ -211,7 +211,7 @@ impl State {
                     return Err("a layer's preset must not be empty".to_string());
                 }
                 let params = presets(&preset)?;
-                stack.layers.push(Layer { preset: Some(preset), params, ..default_layer() });
+                stack.layers.push(Layer { preset: Some(preset), params, ..Layer::filling(Params::default()) });
                 Ok(())
             })?,
             Edit::RemoveLayer { object, layer } => next.edit_stack(object, |stack| {
@@ -357,27 +357,13 @@ fn stack_mut(look: &mut Look, object: ObjectRef) -> &mut ObjectStack {
         None => {
             let layers = match look.objects.iter().find(|o| o.id.is_none()) {
                 Some(default) => default.layers.clone(),
-                None => vec![default_layer()],
+                None => vec![Layer::filling(Params::default())],
             };
             look.objects.push(ObjectStack { id, layers });
             look.objects.len() - 1
         }
     };
     &mut look.objects[index]
-}
-
-/// A layer of the default material, as a look without a default stack shows it.
-fn default_layer() -> Layer {
-    Layer {
-        preset: None,
-        params: Params::default(),
-        overrides: Vec::new(),
-        mask: None,
-        invert: false,
-        opacity: 1.0,
-        enabled: true,
-        line: 0,
-    }
 }
 
 /// Checks that `layer` is an index into a stack of `count` layers.
