@@ -9,6 +9,7 @@ use crate::render::progressive::{self, RenderStats};
 use crate::render::scene::Scene;
 use crate::render::settings::Overrides;
 use crate::render::Renderer;
+use crate::shading::model::Model;
 use crate::{Error, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -137,11 +138,23 @@ fn run_compare(
         None if args.gbuffer.is_none() => "built-in look".to_string(),
         None => "default material".to_string(),
     };
-    let (a, b) = match second_look {
-        Some(b_look) => (load(args.look.as_deref(), overrides)?, load(Some(b_look), overrides)?),
+    // B is either a second look, read on its own, or A's scene with another model: then the
+    // g-buffer and environment are read once and only the model changes between the renders.
+    enum Second {
+        Look(Box<Scene>),
+        Model(Model),
+    }
+    let (mut a, second_scene) = match second_look {
+        Some(b_look) => {
+            (load(args.look.as_deref(), overrides)?, Second::Look(Box::new(load(Some(b_look), overrides)?)))
+        }
         None if !overrides.model.is_empty() => {
-            let own_model = Overrides { model: Vec::new(), ..overrides.clone() };
-            (load(args.look.as_deref(), &own_model)?, load(args.look.as_deref(), overrides)?)
+            let a = load(args.look.as_deref(), &Overrides { model: Vec::new(), ..overrides.clone() })?;
+            let mut model = a.settings.model;
+            for text in &overrides.model {
+                model.set_from_text(text).map_err(Error::input)?;
+            }
+            (a, Second::Model(model))
         }
         None => {
             return Err(Error::input(
@@ -149,16 +162,25 @@ fn run_compare(
             ))
         }
     };
-    let label = |scene: &Scene, look: Option<&Path>| format!("{}, model: {}", look_name(look), scene.settings.model);
-    let a_label = label(&a, args.look.as_deref());
-    let b_label = label(&b, second_look.or(args.look.as_deref()));
+    let label = |model: &Model, look: Option<&Path>| format!("{}, model: {model}", look_name(look));
+    let a_label = label(&a.settings.model, args.look.as_deref());
+    let b_label = match &second_scene {
+        Second::Look(b) => label(&b.settings.model, second_look),
+        Second::Model(model) => label(model, args.look.as_deref()),
+    };
 
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
     let device_name = ctx.info().name.clone();
     let exr = format == OutputFormat::Exr;
     let first = render(&ctx, &a, exr, "rendering A", args.quiet)?;
-    let second = render(&ctx, &b, exr, "rendering B", args.quiet)?;
+    let second = match second_scene {
+        Second::Look(b) => render(&ctx, &b, exr, "rendering B", args.quiet)?,
+        Second::Model(model) => {
+            a.settings.model = model;
+            render(&ctx, &a, exr, "rendering B", args.quiet)?
+        }
+    };
     drop(ctx);
     super::check_validation(&counter)?;
 
