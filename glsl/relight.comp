@@ -23,7 +23,7 @@ layout(local_size_x = 16, local_size_y = 16) in;
 
 // Layer 0: N.xyz and coverage A; layer 1: V.xyz; layer 2: T.xyz (unit, orthogonal to N).
 layout(set = 0, binding = 0, rgba32f) uniform readonly image2DArray surface;
-// The resolved material, four layers as material.glsl unpacks them.
+// The resolved material: four layers as material.glsl unpacks them, then emission (rgb).
 layout(set = 0, binding = 1, rgba32f) uniform readonly image2DArray resolved;
 // Covered pixels: the running sum of the radiance estimates (rgb) and their number (a).
 // Uncovered pixels are never written.
@@ -104,8 +104,17 @@ void main() {
     vec3 b = cross(n, t);
     vec3 v = vec3(dot(view, t), dot(view, b), dot(view, n));
     vec4 sum = pass.first_sample == 0u ? vec4(0.0) : imageLoad(accumulation, pixel);
-    // Facing away from the eye (a shading normal can), the BRDF is zero: nothing to add.
-    if (v.z > 0.0) {
+    // Emission is the surface's own radiance: not scaled by the environment's intensity, and
+    // seen even where the shading normal faces away. It is added with each sample, so that the
+    // sum keeps its sample order.
+    vec3 emission = imageLoad(resolved, ivec3(pixel, 4)).rgb;
+    uint end_sample = pass.first_sample + pass.sample_count;
+    // Facing away from the eye (a shading normal can), the BRDF is zero: only emission.
+    if (v.z <= 0.0) {
+        for (uint i = pass.first_sample; i < end_sample; i++) {
+            sum.rgb += emission;
+        }
+    } else {
         Material m = unpack_material(imageLoad(resolved, ivec3(pixel, 0)), imageLoad(resolved, ivec3(pixel, 1)),
                                      imageLoad(resolved, ivec3(pixel, 2)), imageLoad(resolved, ivec3(pixel, 3)));
         Lobes s = make_lobes(m);
@@ -117,10 +126,11 @@ void main() {
         uint pixel_seed = hash_combine(hash_u32(pass.seed), uint(pixel.y) * uint(size.x) + uint(pixel.x));
         uint env_seed = hash_combine(pixel_seed, 0x454e56u);
         uint brdf_seed = hash_combine(pixel_seed, 0x425244u);
-        for (uint i = pass.first_sample; i < pass.first_sample + pass.sample_count; i++) {
-            sum.rgb += estimate(s, choice, view_terms, fx, fy, fn, sobol_owen_2d(i, env_seed), sobol_owen_2d(i, brdf_seed));
+        for (uint i = pass.first_sample; i < end_sample; i++) {
+            sum.rgb += emission + estimate(s, choice, view_terms, fx, fy, fn, sobol_owen_2d(i, env_seed),
+                                           sobol_owen_2d(i, brdf_seed));
         }
     }
-    sum.a = float(pass.first_sample + pass.sample_count);
+    sum.a = float(end_sample);
     imageStore(accumulation, pixel, sum);
 }

@@ -1,15 +1,17 @@
 #version 460
-// Resolves each pixel's layer stack into one material, parameter by parameter (README: Formats):
-// the bottom layer fills, and each layer above blends in with w = clamp(opacity·m, 0, 1), where m
-// is its mask (or 1 − mask when inverted; 1 without a mask). Runs once per edit, not per sample.
+// Resolves each pixel's layer stack into one material, parameter by parameter (README: Formats).
+// A layer's value at a pixel is its own value times, for each parameter bound to a map, the
+// map's value there. The bottom layer fills, and each layer above blends in with
+// w = clamp(opacity·m, 0, 1), where m is its mask (or 1 − mask when inverted; 1 without a mask).
+// Runs once per edit, not per sample.
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 16, local_size_y = 16) in;
 
 // Per pixel: the index of its object's stack.
 layout(set = 0, binding = 0, r32ui) uniform readonly uimage2D stack_index;
-// The masks the look uses, one layer each.
-layout(set = 0, binding = 1, r32f) uniform readonly image2DArray masks;
+// The g-buffer channels the look uses, masks and map channels alike, one layer each.
+layout(set = 0, binding = 1, r32f) uniform readonly image2DArray channels;
 
 struct Stack {
     uint first_layer;
@@ -22,8 +24,9 @@ layout(set = 0, binding = 2, std430) readonly buffer Stacks {
 };
 
 struct Layer {
-    vec4 params[4];   // the layer's own material, as Params::to_gpu lays it out
-    int mask;         // layer of `masks`, or −1 for none
+    vec4 params[5];   // the layer's own material, as Params::to_gpu lays it out
+    ivec4 maps[5];    // per value of params: the layer of `channels` it is multiplied by, or −1
+    int mask;         // layer of `channels`, or −1 for none
     uint invert;
     float opacity;
     uint pad;
@@ -34,6 +37,23 @@ layout(set = 0, binding = 3, std430) readonly buffer Layers {
 
 layout(set = 0, binding = 4, rgba32f) uniform writeonly image2DArray resolved;
 
+float channel(ivec2 pixel, int layer) {
+    return imageLoad(channels, ivec3(pixel, layer)).r;
+}
+
+// The layer's material at this pixel: its values, each bound one times its map.
+void layer_material(uint index, ivec2 pixel, out vec4 p[5]) {
+    for (int k = 0; k < 5; k++) {
+        p[k] = layers[index].params[k];
+        ivec4 maps = layers[index].maps[k];
+        for (int c = 0; c < 4; c++) {
+            if (maps[c] >= 0) {
+                p[k][c] *= channel(pixel, maps[c]);
+            }
+        }
+    }
+}
+
 void main() {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = imageSize(stack_index);
@@ -41,17 +61,20 @@ void main() {
         return;
     }
     Stack stack = stacks[imageLoad(stack_index, pixel).r];
-    Layer bottom = layers[stack.first_layer];
-    vec4 p[4] = bottom.params;
+    vec4 p[5];
+    layer_material(stack.first_layer, pixel, p);
     for (uint i = 1u; i < stack.layer_count; i++) {
-        Layer layer = layers[stack.first_layer + i];
-        float m = layer.mask >= 0 ? imageLoad(masks, ivec3(pixel, layer.mask)).r : 1.0;
-        float w = clamp(layer.opacity * (layer.invert != 0u ? 1.0 - m : m), 0.0, 1.0);
-        for (int k = 0; k < 4; k++) {
-            p[k] = p[k] * (1.0 - w) + layer.params[k] * w;
+        uint index = stack.first_layer + i;
+        int mask = layers[index].mask;
+        float m = mask >= 0 ? channel(pixel, mask) : 1.0;
+        float w = clamp(layers[index].opacity * (layers[index].invert != 0u ? 1.0 - m : m), 0.0, 1.0);
+        vec4 q[5];
+        layer_material(index, pixel, q);
+        for (int k = 0; k < 5; k++) {
+            p[k] = p[k] * (1.0 - w) + q[k] * w;
         }
     }
-    for (int k = 0; k < 4; k++) {
+    for (int k = 0; k < 5; k++) {
         imageStore(resolved, ivec3(pixel, k), p[k]);
     }
 }

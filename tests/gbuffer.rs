@@ -475,6 +475,63 @@ fn non_finite_coverage_and_masks_are_errors_naming_the_channel() {
 }
 
 #[test]
+fn maps_are_read_as_colour_and_scalar_maps_in_half_or_float() {
+    let disc = Disc::new(10, 10);
+    let ramp = disc.ramp();
+    let mut channels = disc.half_normals();
+    channels.push(half("map.baseColor.R", ramp.clone()));
+    channels.push(float("map.baseColor.G", ramp.iter().map(|v| 1.0 - v)));
+    channels.push(half("map.baseColor.B", vec![0.25; 100]));
+    channels.push(float("map.rough", ramp.iter().map(|v| v * 0.5)));
+    // Two channels of a trio are two scalar maps, not a colour map.
+    channels.push(half("map.partial.R", vec![0.5; 100]));
+    channels.push(half("map.partial.G", vec![0.5; 100]));
+    let path = scratch("maps.exr");
+    write_exr(&path, disc.size(), channels, Compression::PIZ, &[]);
+    let (g, warnings) = read_ok(&path);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let names: Vec<String> = g.maps().iter().map(|m| m.to_string()).collect();
+    assert_eq!(names, ["map.baseColor.R/G/B", "map.partial.G", "map.partial.R", "map.rough"]);
+    assert!((g.maps["baseColor.R"][9] - 1.0).abs() < 1e-3 && g.maps["baseColor.G"][9].abs() < 1e-6);
+    assert_eq!(g.maps["rough"][9], 0.5);
+    use lookdev::gbuffer::MapSource;
+    let trio = ["baseColor.R", "baseColor.G", "baseColor.B"].map(String::from);
+    assert_eq!(g.map_source("baseColor"), Some(MapSource::Color(trio)));
+    assert_eq!(g.map_source("baseColor.G"), Some(MapSource::Channel("baseColor.G".into())));
+    assert_eq!(g.map_source("rough"), Some(MapSource::Channel("rough".into())));
+    assert_eq!(g.map_source("partial"), None);
+    assert_eq!(g.layer_channel("map.rough").map(|v| v[9]), Some(0.5));
+    assert_eq!(g.map_list(), "map.baseColor.R/G/B, map.partial.G, map.partial.R, map.rough");
+}
+
+#[test]
+fn non_finite_maps_are_errors_and_out_of_range_maps_are_clamped_with_a_count() {
+    let disc = Disc::new(10, 10);
+    let mut map = disc.ramp();
+    map[12] = f32::NAN;
+    map[13] = f32::NAN;
+    map[14] = f32::INFINITY;
+    let path = scratch("nan-map.exr");
+    let mut channels = disc.half_normals();
+    channels.push(float("map.albedo.G", map));
+    write_exr(&path, disc.size(), channels, Compression::ZIP16, &[]);
+    read_err(&path, &["channel map.albedo.G has 3 NaN/Inf values", "x=2, y=1"]);
+
+    let mut map = disc.ramp();
+    map[0] = 1.5;
+    map[1] = -0.5;
+    map[2] = 7.0;
+    let path = scratch("clamped-map.exr");
+    let mut channels = disc.half_normals();
+    channels.push(float("map.rough", map));
+    write_exr(&path, disc.size(), channels, Compression::ZIP16, &[]);
+    let (g, warnings) = read_ok(&path);
+    assert_eq!(&g.maps["rough"][..3], &[1.0, 0.0, 1.0]);
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(warnings[0].contains("clamped 3 values of channel map.rough into [0,1]"), "{warnings:?}");
+}
+
+#[test]
 fn object_ids_must_be_non_negative_integers() {
     let disc = Disc::new(10, 10);
     let mut ids: Vec<f32> = disc.ids().into_iter().map(|id| id as f32).collect();
@@ -679,9 +736,34 @@ fn write_then_read_reproduces_the_shaderball() {
     for (name, mask) in &original.masks {
         assert!(close(&g.masks[name], mask), "mask {name}");
     }
+    assert!(g.maps.is_empty());
     let meta = MetaData::read_from_file(&path, false).unwrap();
     assert_eq!(meta.headers.len(), 1);
     assert_eq!(meta.headers[0].compression, Compression::ZIP16);
+}
+
+#[test]
+fn maps_are_written_as_half_and_read_back() {
+    let mut original = GBuffer::shaderball(32, 32);
+    let pixels = original.pixel_count();
+    let ramp: Vec<f32> = (0..pixels).map(|i| i as f32 / (pixels - 1) as f32).collect();
+    for (k, channel) in ["R", "G", "B"].into_iter().enumerate() {
+        original.maps.insert(format!("tex.{channel}"), ramp.iter().map(|v| (v + k as f32 * 0.25) % 1.0).collect());
+    }
+    original.maps.insert("rough".into(), ramp.iter().map(|v| 1.0 - v).collect());
+    let path = scratch("maps-round-trip.exr");
+    original.write(&path).unwrap();
+    let (g, warnings) = read_ok(&path);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(g.maps.keys().collect::<Vec<_>>(), original.maps.keys().collect::<Vec<_>>());
+    for (name, map) in &original.maps {
+        assert!(g.maps[name].iter().zip(map).all(|(a, b)| (a - b).abs() <= 5e-4), "map {name}");
+    }
+    let meta = MetaData::read_from_file(&path, false).unwrap();
+    let channels = &meta.headers[0].channels.list;
+    let rough = channels.iter().find(|c| c.name.eq("map.rough")).expect("map.rough written");
+    assert_eq!(rough.sample_type, SampleType::F16);
+    assert!(channels.iter().any(|c| c.name.eq("map.tex.G")));
 }
 
 #[test]

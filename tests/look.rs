@@ -66,7 +66,7 @@ fn unknown_keys_name_the_table_and_the_expected_keys() {
     assert_eq!(
         error("[[object]]\nid = 1\n[[object.layer]]\npreset = \"gold\"\nmaks = \"stripes\"\n"),
         "looks/shot.toml:5: unknown key 'maks' in [[object.layer]] (expected preset, mask, invert, opacity, enabled, \
-         set); did you mean 'mask'?"
+         set, map); did you mean 'mask'?"
     );
     assert_eq!(
         error("[[object]]\nname = \"ball\"\n[[object.layer]]\n"),
@@ -154,6 +154,31 @@ fn layer_values_are_checked() {
     assert_eq!(error(&layer("mask = \"\"")), "looks/shot.toml:5: mask must not be empty");
     assert_eq!(error(&layer("enabled = 0")), "looks/shot.toml:5: enabled must be true or false, not the integer 0");
     assert_eq!(error(&layer("preset = 7")), "looks/shot.toml:5: preset must be a string, not the integer 7");
+}
+
+#[test]
+fn map_bindings_are_checked() {
+    let map = |body: &str| format!("[[object]]\n[[object.layer]]\npreset = \"gold\"\n[object.layer.map]\n{body}\n");
+    assert_eq!(
+        error(&map("rougness = \"r\"")),
+        "looks/shot.toml:5: unknown parameter 'rougness' in [object.layer.map] (expected base_color, metallic, \
+         subsurface, specular, specular_tint, roughness, anisotropic, sheen, sheen_tint, clearcoat, clearcoat_gloss, \
+         emission); did you mean 'roughness'?"
+    );
+    assert_eq!(error(&map("roughness = 0.5")), "looks/shot.toml:5: roughness must be a string, not the number 0.5");
+    assert_eq!(error(&map("roughness = \"\"")), "looks/shot.toml:5: roughness must not be empty");
+    assert_eq!(
+        error(&map("roughness = \"map.rough\"")),
+        "looks/shot.toml:5: roughness = \"map.rough\": name the map without the channel prefix, as \"rough\""
+    );
+    assert_eq!(
+        error(&map("roughness = \" rough\"")),
+        "looks/shot.toml:5: roughness = \" rough\": a map's name has no spaces around it"
+    );
+    assert_eq!(
+        error("[[object]]\n[[object.layer]]\n[object.layer.map]\nbase_color = \"a\"\nbase_color = \"b\"\n"),
+        "looks/shot.toml:5: duplicate key 'base_color'"
+    );
 }
 
 #[test]
@@ -360,13 +385,26 @@ opacity = 0.1
 [object.layer.set]
 base_color = [0.9, 0.1, 0.3]
 clearcoat = 2.5
+emission = [4.0, 2.0, 0.5]
+[object.layer.map]
+base_color = "albedo"
+roughness = "metalRough.G"
+emission = "glow"
 "#;
     write(&path, text);
     let look = Look::load(&path).unwrap();
+    let gold = &look.objects[1].layers[1];
+    assert_eq!(gold.params.emission, [4.0, 2.0, 0.5]);
+    let maps: Vec<(Param, &str)> = gold.maps.iter().map(|(p, m)| (*p, m.as_str())).collect();
+    assert_eq!(maps, [(Param::BaseColor, "albedo"), (Param::Roughness, "metalRough.G"), (Param::Emission, "glow")]);
     let written = look.to_toml();
+    assert!(written.contains("[object.layer.map]\nbase_color = \"albedo\"\nroughness = \"metalRough.G\""), "{written}");
     let again = Look::parse(&written, &path).unwrap();
     assert_eq!(again, look, "{written}");
     assert_eq!(again.to_toml(), written);
+    let mut unbound = look.clone();
+    unbound.objects[1].layers[1].maps.clear();
+    assert_ne!(unbound, look, "bindings are part of what a look means");
 
     let builtin = Look::builtin_default();
     let mut again = Look::parse(&builtin.to_toml(), Path::new(SHOT)).unwrap();

@@ -252,8 +252,7 @@ fn gbuffer_and_stacks(size: u32, params: &Params) -> (GBuffer, PackedStacks) {
     let mut look = Look::default_material();
     look.objects[0].layers[0].params = *params;
     let ids = lookdev::render::scene::covered_object_ids(&gbuffer);
-    let masks: Vec<String> = gbuffer.masks.keys().cloned().collect();
-    let stacks = PackedStacks::pack(&look, ids, &masks, Path::new("test g-buffer")).unwrap();
+    let stacks = PackedStacks::pack(&look, ids, &gbuffer, Path::new("test g-buffer")).unwrap();
     (gbuffer, stacks)
 }
 
@@ -377,8 +376,7 @@ fn switching_models_never_changes_the_default_render() {
         "[[object]]\n[[object.layer]]\npreset = \"car-paint\"\n[[object.layer]]\npreset = \"gold\"\nmask = \"left\"\n",
     );
     let ids = lookdev::render::scene::covered_object_ids(&gbuffer);
-    let masks: Vec<String> = gbuffer.masks.keys().cloned().collect();
-    let stacks = PackedStacks::pack(&look, ids, &masks, Path::new("test g-buffer")).unwrap();
+    let stacks = PackedStacks::pack(&look, ids, &gbuffer, Path::new("test g-buffer")).unwrap();
     let render = |r: &mut Renderer| {
         r.set_stacks(&stacks).unwrap();
         r.set_lighting(Lighting::default());

@@ -100,7 +100,7 @@ impl Probe {
         distribution: &Distribution,
     ) -> Vec<(Vec3, f32)> {
         let ctx = &self.ctx;
-        let setup = Setup { params: params.to_gpu(), view: view.extend(0.0).to_array(), routine, seed, pad: [0; 2] };
+        let setup = Setup { params: params.brdf_gpu(), view: view.extend(0.0).to_array(), routine, seed, pad: [0; 2] };
         let setup = Buffer::with_data(ctx, bytemuck::bytes_of(&setup)).unwrap();
         let flat: Vec<f32> = uniforms.iter().flat_map(|u| [u.x, u.y]).collect();
         let uniforms_buffer = Buffer::with_data(ctx, bytemuck::cast_slice(&flat)).unwrap();

@@ -1,4 +1,6 @@
-// The eleven Disney parameters (and the complex IOR's edge parameter) and their GPU layout: four vec4s, as Params::to_gpu writes them.
+// The eleven Disney parameters (and the complex IOR's edge parameter) and their GPU layout: the
+// first four of the five vec4s Params::to_gpu writes. The fifth holds emission, which is no part
+// of the BRDF: relight.comp reads it on its own.
 #ifndef LOOKDEV_MATERIAL_GLSL
 #define LOOKDEV_MATERIAL_GLSL
 

@@ -664,6 +664,7 @@ impl Accumulator {
             coverage,
             object_id,
             masks,
+            maps: BTreeMap::new(),
             object_names,
             has_view: true,
             has_tangent: true,

@@ -16,8 +16,20 @@
 //! | `A` | coverage in \[0,1\]; 0 is background | 1 where \|N\| > 0.5, else 0 |
 //! | `objectId` | integer object ID: uint, or half/float holding non-negative integers | 0 |
 //! | `mask.<name>` | layer mask in \[0,1\], named `<name>` in looks | — |
+//! | `map.<name>` | a scalar parameter map in \[0,1\], linear, named `<name>` in looks | — |
+//! | `map.<name>.R .G .B` | a colour parameter map in \[0,1\], linear | — |
 //!
 //! A triple must be complete: `V.X` without `V.Y` is an error. Other channels are ignored.
+//!
+//! # Maps
+//!
+//! A map holds one parameter's texture per pixel. A layer binds a parameter to it in its
+//! `[object.layer.map]` table, and the parameter's value at a pixel is then the layer's value
+//! times the map's: glTF's factor × texture. Three channels `map.<name>.R`, `.G` and `.B` make
+//! the colour map `<name>`, whose single channels are named `<name>.R` and so on; any other
+//! `map.*` channel is a scalar map named by the rest of its channel name. Maps are read and
+//! checked like masks: half or float, NaN/Inf is an error, values outside \[0,1\] are clamped
+//! with a warning. So a bound value never leaves its parameter's range.
 //!
 //! Prefer a lossless compression (ZIP, PIZ) for g-buffers. DWAA and DWAB treat every channel
 //! whose name ends in `.Y` as luminance and quantise it, so `N.Y`, `V.Y` and `T.Y` come back
@@ -38,19 +50,19 @@
 //! empty vector (\|N\| ≤ 0.5). Reading fails, with one line naming the file and the problem, on:
 //! a missing file; a file the `exr` crate cannot read; more than one part; an empty image; a
 //! missing `N.*` channel; an incomplete triple; NaN/Inf normals at covered pixels; \|N\| < 0.5
-//! where `A` > 0; NaN/Inf or zero-length view vectors anywhere; NaN/Inf in `A` or a mask; and
+//! where `A` > 0; NaN/Inf or zero-length view vectors anywhere; NaN/Inf in `A`, a mask or a map; and
 //! object IDs that are negative or not integers. Counts and the first offending pixel are given.
 //!
 //! These are fixed, with one warning line each, naming the file and the count:
 //! normals at covered pixels whose length is off by more than 1% (all normals are renormalised
-//! anyway, since half floats are not exactly unit); `A` and mask values outside \[0,1\] (clamped);
+//! anyway, since half floats are not exactly unit); `A`, mask and map values outside \[0,1\] (clamped);
 //! tangents at covered pixels that are zero, NaN/Inf or parallel to N (replaced by the stable
 //! frame). Stored tangents are otherwise made orthogonal to N by Gram–Schmidt.
 //!
 //! # Writing, and the built-in scene
 //!
 //! [`GBuffer::write`] stores `N.*` (and `V.*`, `T.*` where the g-buffer has them) as float, `A`
-//! and masks as half, `objectId` as uint, ZIP-compressed, through a temporary file that is
+//! masks and maps as half, `objectId` as uint, ZIP-compressed, through a temporary file that is
 //! renamed into place. [`GBuffer::shaderball`] makes the built-in look-dev scene without a file.
 
 mod frame;
@@ -76,6 +88,10 @@ pub const COVERAGE_CHANNEL: &str = "A";
 pub const OBJECT_ID_CHANNEL: &str = "objectId";
 /// A mask channel is this prefix followed by the mask's name.
 pub const MASK_PREFIX: &str = "mask.";
+/// A map channel is this prefix followed by the map's name (and `.R`/`.G`/`.B` for a colour).
+pub const MAP_PREFIX: &str = "map.";
+/// The channel suffixes of a colour map.
+pub const COLOR_MAP_CHANNELS: [&str; 3] = ["R", "G", "B"];
 /// An object's name is stored in the header attribute with this prefix followed by its ID.
 pub const OBJECT_NAME_PREFIX: &str = "objectName.";
 
@@ -108,6 +124,9 @@ pub struct GBuffer {
     pub object_id: Vec<u32>,
     /// Layer masks in \[0,1\], keyed by name without the `mask.` prefix.
     pub masks: BTreeMap<String, Vec<f32>>,
+    /// Parameter map channels in \[0,1\], keyed by channel name without the `map.` prefix
+    /// (`baseColor.R`, `rough`); [`GBuffer::maps`] tells colour maps from scalar ones.
+    pub maps: BTreeMap<String, Vec<f32>>,
     /// Object names by ID, from the `objectName.<ID>` header attributes.
     pub object_names: BTreeMap<u32, String>,
     /// Whether the file carried `V.*`.
@@ -116,9 +135,89 @@ pub struct GBuffer {
     pub has_tangent: bool,
 }
 
+/// A map in a g-buffer, as a look names it.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub struct MapInfo {
+    pub name: String,
+    /// Whether it is a colour map (`map.<name>.R/G/B`) rather than a scalar one (`map.<name>`).
+    pub color: bool,
+}
+
+impl std::fmt::Display for MapInfo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.color {
+            write!(f, "{MAP_PREFIX}{}.R/G/B", self.name)
+        } else {
+            write!(f, "{MAP_PREFIX}{}", self.name)
+        }
+    }
+}
+
+/// What a map binding names: one channel used as a value (a scalar map, or one channel of a
+/// colour map), or a whole colour map.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum MapSource {
+    /// The channel's key in [`GBuffer::maps`].
+    Channel(String),
+    /// The keys of the colour map's R, G and B channels.
+    Color([String; 3]),
+}
+
 impl GBuffer {
     /// The number of pixels, `width * height`.
     pub fn pixel_count(&self) -> usize {
         self.width as usize * self.height as usize
+    }
+
+    /// The maps, by name: colour maps for every complete `.R/.G/.B` trio, scalar maps for every
+    /// other map channel.
+    pub fn maps(&self) -> Vec<MapInfo> {
+        let mut maps = Vec::new();
+        for channel in self.maps.keys() {
+            match self.color_map_of(channel) {
+                Some(name) if channel.ends_with(".R") => maps.push(MapInfo { name: name.to_string(), color: true }),
+                Some(_) => {}
+                None => maps.push(MapInfo { name: channel.clone(), color: false }),
+            }
+        }
+        maps.sort();
+        maps
+    }
+
+    /// The colour map a channel belongs to, when it ends in `.R`, `.G` or `.B` and its two
+    /// siblings are there too.
+    fn color_map_of<'a>(&self, channel: &'a str) -> Option<&'a str> {
+        let (name, suffix) = channel.rsplit_once('.')?;
+        (COLOR_MAP_CHANNELS.contains(&suffix)
+            && COLOR_MAP_CHANNELS.iter().all(|c| self.maps.contains_key(&format!("{name}.{c}"))))
+        .then_some(name)
+    }
+
+    /// What a binding's map name refers to: a colour map by its name, or a single channel (a
+    /// scalar map, or `name.R|G|B` of a colour map). `None` when the g-buffer has no such map.
+    pub fn map_source(&self, name: &str) -> Option<MapSource> {
+        let trio = COLOR_MAP_CHANNELS.map(|c| format!("{name}.{c}"));
+        if trio.iter().all(|c| self.maps.contains_key(c)) {
+            return Some(MapSource::Color(trio));
+        }
+        self.maps.contains_key(name).then(|| MapSource::Channel(name.to_string()))
+    }
+
+    /// The maps, listed for a message: "map.baseColor.R/G/B, map.rough", or "no maps".
+    pub fn map_list(&self) -> String {
+        let maps = self.maps();
+        if maps.is_empty() {
+            "no maps".to_string()
+        } else {
+            maps.iter().map(MapInfo::to_string).collect::<Vec<_>>().join(", ")
+        }
+    }
+
+    /// A mask or map channel by its full channel name (`mask.stripes`, `map.baseColor.R`).
+    pub fn layer_channel(&self, channel: &str) -> Option<&[f32]> {
+        if let Some(name) = channel.strip_prefix(MASK_PREFIX) {
+            return self.masks.get(name).map(Vec::as_slice);
+        }
+        channel.strip_prefix(MAP_PREFIX).and_then(|name| self.maps.get(name)).map(Vec::as_slice)
     }
 }

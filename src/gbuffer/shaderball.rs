@@ -59,6 +59,7 @@ impl GBuffer {
             coverage: pixels.iter().map(|p| p.coverage).collect(),
             object_id: pixels.iter().map(|p| p.object_id).collect(),
             masks,
+            maps: BTreeMap::new(),
             object_names: BTreeMap::from([(BALL_ID, BALL_NAME.to_string()), (PEDESTAL_ID, PEDESTAL_NAME.to_string())]),
             has_view: true,
             has_tangent: true,

@@ -11,8 +11,8 @@ use glam::Vec3;
 
 use super::frame::{orthogonalize, stable_tangent};
 use super::{
-    GBuffer, COVERAGE_CHANNEL, DEFAULT_VIEW, MASK_PREFIX, NORMAL_CHANNELS, OBJECT_ID_CHANNEL, OBJECT_NAME_PREFIX,
-    PLACEHOLDER_NORMAL, TANGENT_CHANNELS, VIEW_CHANNELS,
+    GBuffer, COVERAGE_CHANNEL, DEFAULT_VIEW, MAP_PREFIX, MASK_PREFIX, NORMAL_CHANNELS, OBJECT_ID_CHANNEL,
+    OBJECT_NAME_PREFIX, PLACEHOLDER_NORMAL, TANGENT_CHANNELS, VIEW_CHANNELS,
 };
 use crate::{Error, Result};
 
@@ -77,7 +77,8 @@ impl Checker<'_> {
             Some(samples) => self.object_ids(samples)?,
             None => vec![0; normal.len()],
         };
-        let masks = self.masks(&raw.channels)?;
+        let masks = self.prefixed(&raw.channels, MASK_PREFIX)?;
+        let maps = self.prefixed(&raw.channels, MAP_PREFIX)?;
         let object_names = self.object_names(&raw.object_name_attributes);
 
         let gbuffer = GBuffer {
@@ -89,6 +90,7 @@ impl Checker<'_> {
             coverage,
             object_id,
             masks,
+            maps,
             object_names,
             has_view: raw_view.is_some(),
             has_tangent: raw_tangent.is_some(),
@@ -348,16 +350,20 @@ impl Checker<'_> {
         Ok(ids)
     }
 
-    /// Every `mask.<name>` channel, keyed by `<name>`.
-    fn masks(&mut self, channels: &BTreeMap<String, FlatSamples>) -> Result<BTreeMap<String, Vec<f32>>> {
-        let mut masks = BTreeMap::new();
+    /// Every `<prefix><name>` channel (masks, maps), keyed by `<name>`, each in \[0,1\].
+    fn prefixed(
+        &mut self,
+        channels: &BTreeMap<String, FlatSamples>,
+        prefix: &str,
+    ) -> Result<BTreeMap<String, Vec<f32>>> {
+        let mut found = BTreeMap::new();
         for (channel, samples) in channels {
-            let Some(name) = channel.strip_prefix(MASK_PREFIX).filter(|name| !name.is_empty()) else {
+            let Some(name) = channel.strip_prefix(prefix).filter(|name| !name.is_empty()) else {
                 continue;
             };
-            masks.insert(name.to_string(), self.unit_interval(channel, samples)?);
+            found.insert(name.to_string(), self.unit_interval(channel, samples)?);
         }
-        Ok(masks)
+        Ok(found)
     }
 
     /// Object names from `objectName.<ID>` text attributes; malformed ones are skipped.
@@ -439,6 +445,7 @@ fn is_gbuffer_channel(name: &str) -> bool {
         || name == COVERAGE_CHANNEL
         || name == OBJECT_ID_CHANNEL
         || name.starts_with(MASK_PREFIX)
+        || name.starts_with(MAP_PREFIX)
 }
 
 #[cfg(test)]
@@ -482,6 +489,11 @@ mod tests {
         channels.push(("mask.a", FlatSamples::F16(vec![half::f16::ZERO; 1])));
         let message = error_of(raw(2, 2, channels));
         assert!(message.contains("channel mask.a has 1 samples for 2x2 pixels"), "{message}");
+
+        let mut channels = normals(4);
+        channels.push(("map.rough", FlatSamples::F16(vec![half::f16::ZERO; 2])));
+        let message = error_of(raw(2, 2, channels));
+        assert!(message.contains("channel map.rough has 2 samples for 2x2 pixels"), "{message}");
 
         let mut channels = normals(4);
         channels.push(("RY", FlatSamples::F16(vec![half::f16::ZERO; 1])));

@@ -9,14 +9,14 @@ use exr::prelude::{
 use half::f16;
 
 use super::{
-    GBuffer, COVERAGE_CHANNEL, MASK_PREFIX, NORMAL_CHANNELS, OBJECT_ID_CHANNEL, OBJECT_NAME_PREFIX, TANGENT_CHANNELS,
-    VIEW_CHANNELS,
+    GBuffer, COVERAGE_CHANNEL, MAP_PREFIX, MASK_PREFIX, NORMAL_CHANNELS, OBJECT_ID_CHANNEL, OBJECT_NAME_PREFIX,
+    TANGENT_CHANNELS, VIEW_CHANNELS,
 };
 use crate::{Error, Result};
 
 impl GBuffer {
     /// Writes the g-buffer as a single-part, ZIP-compressed EXR: `N.*` always, `V.*` if
-    /// `has_view`, `T.*` if `has_tangent` (all float), `A` and masks as half, `objectId` as uint,
+    /// `has_view`, `T.*` if `has_tangent` (all float), `A`, masks and maps as half, `objectId` as uint,
     /// and object names as `objectName.<ID>` attributes.
     ///
     /// The file appears atomically: it is written to a temporary file in the same folder, then
@@ -42,7 +42,7 @@ impl GBuffer {
             ("coverage", self.coverage.len()),
             ("object_id", self.object_id.len()),
         ];
-        lengths.extend(self.masks.iter().map(|(name, mask)| (name.as_str(), mask.len())));
+        lengths.extend(self.masks.iter().chain(&self.maps).map(|(name, values)| (name.as_str(), values.len())));
         if pixels == 0 {
             return Err(Error::io(path, "cannot write an empty g-buffer"));
         }
@@ -72,6 +72,9 @@ impl GBuffer {
         for (name, mask) in &self.masks {
             channels.push(half_channel(&format!("{MASK_PREFIX}{name}"), mask));
         }
+        for (name, map) in &self.maps {
+            channels.push(half_channel(&format!("{MAP_PREFIX}{name}"), map));
+        }
 
         let mut attributes = LayerAttributes { software_name: Some(text("lookdev")), ..LayerAttributes::default() };
         for (id, name) in &self.object_names {
@@ -93,7 +96,7 @@ fn vector_channels(names: [&str; 3], vectors: &[[f32; 3]]) -> [AnyChannel<FlatSa
     })
 }
 
-/// A half-float channel: coverage and masks need no more than 11 bits.
+/// A half-float channel: coverage, masks and maps (from 8-bit textures) need no more than 11 bits.
 fn half_channel(name: &str, values: &[f32]) -> AnyChannel<FlatSamples> {
     AnyChannel::new(text(name), FlatSamples::F16(values.iter().map(|&v| f16::from_f32(v)).collect()))
 }

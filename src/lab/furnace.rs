@@ -28,6 +28,7 @@ pub fn sphere(size: u32) -> GBuffer {
         coverage: Vec::with_capacity(pixels),
         object_id: Vec::with_capacity(pixels),
         masks: BTreeMap::new(),
+        maps: BTreeMap::new(),
         object_names: BTreeMap::from([(1, "sphere".to_string())]),
         has_view: false,
         has_tangent: false,
@@ -79,7 +80,7 @@ pub fn render(
             let params = Params { metallic: m, roughness: r, ..*base };
             let mut look = Look::default_material();
             look.objects[0].layers[0].params = params;
-            let stacks = PackedStacks::pack(&look, vec![1], &[], Path::new("furnace"))?;
+            let stacks = PackedStacks::pack(&look, vec![1], &gbuffer, Path::new("furnace"))?;
             renderer.set_stacks(&stacks)?;
             crate::render::progressive::accumulate(&mut renderer, spp, |_| {})?;
             let radiance = renderer.read_radiance()?;

@@ -29,6 +29,10 @@
 //! enabled = true         # false keeps the layer but leaves it out of the render
 //! [object.layer.set]     # per-parameter overrides on top of the preset
 //! roughness = 0.25
+//! [object.layer.map]     # per-parameter maps: the value here is the layer's times the map's
+//! base_color = "baseColor"     # the g-buffer's colour map map.baseColor.R/G/B
+//! metallic = "metalRough.B"    # one channel of a colour map
+//! roughness = "rough"          # the g-buffer's scalar map map.rough
 //! ```
 //!
 //! A layer without `preset` starts from the default parameters. The bottom layer fills the
@@ -106,6 +110,10 @@ pub struct Layer {
     pub params: Params,
     /// Which parameters `[object.layer.set]` set, in [`Param::ALL`] order.
     pub overrides: Vec<Param>,
+    /// `[object.layer.map]`: the parameters bound to a g-buffer map, each with the map as
+    /// written (`name`, or `name.R`/`.G`/`.B` for one channel of a colour map). Checked against
+    /// the g-buffer when the stacks are packed.
+    pub maps: BTreeMap<Param, String>,
     /// The g-buffer channel `mask.<name>`; `None` is 1 everywhere.
     pub mask: Option<String>,
     pub invert: bool,
@@ -127,6 +135,7 @@ impl Layer {
             preset: None,
             params,
             overrides: Vec::new(),
+            maps: BTreeMap::new(),
             mask: None,
             invert: false,
             opacity: 1.0,
@@ -143,6 +152,7 @@ impl PartialEq for Layer {
         self.preset == other.preset
             && self.params == other.params
             && self.overrides == other.overrides
+            && self.maps == other.maps
             && self.mask == other.mask
             && self.invert == other.invert
             && self.opacity == other.opacity
@@ -309,6 +319,12 @@ impl Layer {
                 lines.push(format!("{param} = {}", input::value(self.params.get(param))));
             }
         }
+        if !self.maps.is_empty() {
+            lines.push("[object.layer.map]".to_string());
+            for (param, map) in &self.maps {
+                lines.push(format!("{param} = {}", input::quoted(map)));
+            }
+        }
     }
 }
 
@@ -377,6 +393,8 @@ struct LayerFile {
     /// Parameter name to value; names are checked here rather than by serde so that an unknown
     /// one can be reported as a parameter, with the closest name.
     set: Option<BTreeMap<Field<String>, Field>>,
+    /// Parameter name to map name, checked like `set`.
+    map: Option<BTreeMap<Field<String>, Field>>,
 }
 
 fn parse_with(src: Source, library: &Library) -> crate::Result<Look> {
@@ -476,16 +494,24 @@ fn layer(src: &Source, raw: &Field<LayerFile>, library: &Library) -> crate::Resu
     }
     let mut overrides = Vec::new();
     for (key, value) in fields.set.iter().flatten() {
-        let param =
-            Param::from_name(key.get_ref()).ok_or_else(|| src.error(key.span(), unknown_param(key.get_ref())))?;
+        let param = Param::from_name(key.get_ref())
+            .ok_or_else(|| src.error(key.span(), unknown_param(key.get_ref(), "[object.layer.set]")))?;
         input::set_param(&mut params, param, value.get_ref()).map_err(|problem| src.error(value.span(), problem))?;
         overrides.push(param);
     }
     overrides.sort();
+    let mut maps = BTreeMap::new();
+    for (key, value) in fields.map.iter().flatten() {
+        let param = Param::from_name(key.get_ref())
+            .ok_or_else(|| src.error(key.span(), unknown_param(key.get_ref(), "[object.layer.map]")))?;
+        let map = map_name(param.name(), value.get_ref()).map_err(|problem| src.error(value.span(), problem))?;
+        maps.insert(param, map);
+    }
     Ok(Layer {
         preset,
         params,
         overrides,
+        maps,
         mask: src.read("mask", &fields.mask, input::text)?,
         invert: src.read("invert", &fields.invert, input::boolean)?.unwrap_or(false),
         opacity: src.read("opacity", &fields.opacity, unit_interval)?.unwrap_or(1.0),
@@ -494,9 +520,21 @@ fn layer(src: &Source, raw: &Field<LayerFile>, library: &Library) -> crate::Resu
     })
 }
 
-fn unknown_param(name: &str) -> String {
+fn unknown_param(name: &str, table: &str) -> String {
     let names = Param::ALL.map(Param::name);
-    input::unknown("parameter", name, "in [object.layer.set]", &names)
+    input::unknown("parameter", name, &format!("in {table}"), &names)
+}
+
+/// A map's name as a binding gives it: `name` or `name.R|G|B`, without the `map.` prefix.
+fn map_name(key: &str, value: &toml::Value) -> Result<String, String> {
+    let name = input::text(key, value)?;
+    if let Some(stripped) = name.strip_prefix(crate::gbuffer::MAP_PREFIX) {
+        return Err(format!("{key} = {name:?}: name the map without the channel prefix, as \"{stripped}\""));
+    }
+    if name.trim() != name {
+        return Err(format!("{key} = {name:?}: a map's name has no spaces around it"));
+    }
+    Ok(name)
 }
 
 fn non_negative(key: &str, value: &toml::Value) -> Result<f32, String> {

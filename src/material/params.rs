@@ -1,4 +1,5 @@
-//! The eleven parameters of the Disney 2012 principled BRDF, their defaults, ranges and GPU layout.
+//! The eleven parameters of the Disney 2012 principled BRDF, plus emission, their defaults, ranges
+//! and GPU layout.
 
 use std::fmt;
 
@@ -8,6 +9,9 @@ use std::fmt;
 pub const SPECULAR_MAX: f32 = 2.5;
 pub const SHEEN_MAX: f32 = 2.0;
 pub const CLEARCOAT_MAX: f32 = 4.0;
+/// The largest emitted radiance per channel: the largest half float, so that any value
+/// survives a half-float EXR.
+pub const EMISSION_MAX: f32 = 65504.0;
 
 /// One BRDF parameter, by name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -23,11 +27,15 @@ pub enum Param {
     SheenTint,
     Clearcoat,
     ClearcoatGloss,
+    /// Not part of the Disney BRDF: the surface's own radiance, added to the reflected light, so
+    /// that emissive assets look like themselves.
+    Emission,
 }
 
 impl Param {
-    /// All parameters, in the order of Burley's figure 16 and of the GPU layout.
-    pub const ALL: [Param; 11] = [
+    /// All parameters: Burley's eleven in the order of his figure 16 and of the GPU layout,
+    /// then emission.
+    pub const ALL: [Param; 12] = [
         Param::BaseColor,
         Param::Metallic,
         Param::Subsurface,
@@ -39,6 +47,7 @@ impl Param {
         Param::SheenTint,
         Param::Clearcoat,
         Param::ClearcoatGloss,
+        Param::Emission,
     ];
 
     /// The name used in presets, looks and on the command line.
@@ -55,6 +64,7 @@ impl Param {
             Param::SheenTint => "sheen_tint",
             Param::Clearcoat => "clearcoat",
             Param::ClearcoatGloss => "clearcoat_gloss",
+            Param::Emission => "emission",
         }
     }
 
@@ -62,8 +72,9 @@ impl Param {
         Param::ALL.into_iter().find(|p| p.name() == name)
     }
 
+    /// Whether the value is a linear RGB colour (`base_color`, `emission`) rather than a number.
     pub fn is_color(self) -> bool {
-        self == Param::BaseColor
+        matches!(self, Param::BaseColor | Param::Emission)
     }
 
     /// The largest value allowed (the smallest is always 0).
@@ -72,12 +83,13 @@ impl Param {
             Param::Specular => SPECULAR_MAX,
             Param::Sheen => SHEEN_MAX,
             Param::Clearcoat => CLEARCOAT_MAX,
+            Param::Emission => EMISSION_MAX,
             _ => 1.0,
         }
     }
 
     /// Where the parameter sits in [`Params::to_gpu`]'s layout (a colour takes three places).
-    fn gpu_index(self) -> usize {
+    pub fn gpu_index(self) -> usize {
         match self {
             Param::BaseColor => 0,
             Param::Metallic => 3,
@@ -90,6 +102,7 @@ impl Param {
             Param::SheenTint => 10,
             Param::Clearcoat => 11,
             Param::ClearcoatGloss => 12,
+            Param::Emission => 16,
         }
     }
 
@@ -121,8 +134,8 @@ impl fmt::Display for Value {
     }
 }
 
-/// The eleven parameters of one material. All are normalised to [0, 1] except where
-/// [`Param::max`] allows more; colours are linear Rec.709.
+/// The twelve parameters of one material: the eleven of the BRDF, and emission. All are
+/// normalised to [0, 1] except where [`Param::max`] allows more; colours are linear Rec.709.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params {
     pub base_color: [f32; 3],
@@ -141,6 +154,8 @@ pub struct Params {
     /// `base_color` (its F0) and this give (n, k) back. 0 for a dielectric. Only the
     /// `conductor` Fresnel model reads it; it blends between layers like every parameter.
     pub ior_edge: [f32; 3],
+    /// Emitted radiance, linear Rec.709, added to the reflected light; 0 by default.
+    pub emission: [f32; 3],
 }
 
 impl Default for Params {
@@ -158,19 +173,24 @@ impl Default for Params {
             clearcoat: 0.0,
             clearcoat_gloss: 1.0,
             ior_edge: [0.0; 3],
+            emission: [0.0; 3],
         }
     }
 }
 
-/// Number of floats in the GPU layout of [`Params`]: four vec4s.
-pub const GPU_FLOATS: usize = 16;
+/// Number of floats in the GPU layout of [`Params`]: five vec4s.
+pub const GPU_FLOATS: usize = 20;
+/// The BRDF's part of that layout, the first four vec4s: what `material.glsl` unpacks.
+pub const BRDF_GPU_FLOATS: usize = 16;
 
 impl Params {
     pub fn get(&self, param: Param) -> Value {
         let g = self.to_gpu();
-        match param {
-            Param::BaseColor => Value::Color([g[0], g[1], g[2]]),
-            _ => Value::Scalar(g[param.gpu_index()]),
+        let i = param.gpu_index();
+        if param.is_color() {
+            Value::Color([g[i], g[i + 1], g[i + 2]])
+        } else {
+            Value::Scalar(g[i])
         }
     }
 
@@ -179,9 +199,10 @@ impl Params {
     pub fn set(&mut self, param: Param, value: Value) -> Result<(), String> {
         check(param, value)?;
         let mut g = self.to_gpu();
+        let i = param.gpu_index();
         match value {
-            Value::Color(c) => g[..3].copy_from_slice(&c),
-            Value::Scalar(v) => g[param.gpu_index()] = v,
+            Value::Color(c) => g[i..i + 3].copy_from_slice(&c),
+            Value::Scalar(v) => g[i] = v,
         }
         *self = Params::from_gpu(&g);
         Ok(())
@@ -189,9 +210,11 @@ impl Params {
 
     /// The GPU layout, mirrored by `glsl/include/material.glsl`:
     /// `[base_color.rgb, metallic] [subsurface, specular, specular_tint, roughness]
-    ///  [anisotropic, sheen, sheen_tint, clearcoat] [clearcoat_gloss, ior_edge.rgb]`.
+    ///  [anisotropic, sheen, sheen_tint, clearcoat] [clearcoat_gloss, ior_edge.rgb]
+    ///  [emission.rgb, 0]`.
     pub fn to_gpu(&self) -> [f32; GPU_FLOATS] {
         let [r, g, b] = self.base_color;
+        let [er, eg, eb] = self.emission;
         [
             r,
             g,
@@ -209,7 +232,18 @@ impl Params {
             self.ior_edge[0],
             self.ior_edge[1],
             self.ior_edge[2],
+            er,
+            eg,
+            eb,
+            0.0,
         ]
+    }
+
+    /// The BRDF's part of [`Params::to_gpu`], for kernels that evaluate only the BRDF.
+    pub fn brdf_gpu(&self) -> [f32; BRDF_GPU_FLOATS] {
+        let mut brdf = [0.0; BRDF_GPU_FLOATS];
+        brdf.copy_from_slice(&self.to_gpu()[..BRDF_GPU_FLOATS]);
+        brdf
     }
 
     pub fn from_gpu(v: &[f32; GPU_FLOATS]) -> Params {
@@ -226,6 +260,7 @@ impl Params {
             clearcoat: v[11],
             clearcoat_gloss: v[12],
             ior_edge: [v[13], v[14], v[15]],
+            emission: [v[16], v[17], v[18]],
         }
     }
 
@@ -247,7 +282,7 @@ pub fn check(param: Param, value: Value) -> Result<(), String> {
             if c.iter().all(|&v| in_range(v)) {
                 Ok(())
             } else {
-                Err(format!("{param} = {value} is out of range: each channel must be in [0, 1] (linear)"))
+                Err(format!("{param} = {value} is out of range: each channel must be in [0, {max}] (linear)"))
             }
         }
         (false, Value::Scalar(v)) => {
@@ -290,9 +325,12 @@ mod tests {
             base_color: [0.1, 0.2, 0.3],
             clearcoat_gloss: 0.7,
             ior_edge: [0.2, 0.4, 0.6],
+            emission: [2.0, 0.5, 0.0],
             ..Params::default()
         };
         assert_eq!(Params::from_gpu(&params.to_gpu()), params);
+        assert_eq!(params.get(Param::Emission), Value::Color([2.0, 0.5, 0.0]));
+        assert_eq!(params.get(Param::BaseColor), Value::Color([0.1, 0.2, 0.3]));
     }
 
     #[test]
@@ -304,6 +342,11 @@ mod tests {
         assert!(p.set(Param::Specular, Value::Scalar(2.6)).is_err());
         assert!(p.set(Param::BaseColor, Value::Scalar(0.5)).is_err());
         assert!(p.set(Param::BaseColor, Value::Color([0.5, -0.1, 0.2])).is_err());
+        assert!(p.set(Param::BaseColor, Value::Color([1.5, 0.1, 0.2])).is_err());
+        assert!(p.set(Param::Emission, Value::Color([1.5, 20.0, 0.0])).is_ok());
+        assert_eq!(p.emission, [1.5, 20.0, 0.0]);
+        assert!(p.set(Param::Emission, Value::Color([70000.0, 0.0, 0.0])).is_err());
+        assert!(p.set(Param::Emission, Value::Scalar(1.0)).is_err());
         assert_eq!(parse_value(Param::BaseColor, "0.9,0.6,0.3"), Ok(Value::Color([0.9, 0.6, 0.3])));
         assert_eq!(parse_value(Param::Metallic, "1"), Ok(Value::Scalar(1.0)));
         assert!(parse_value(Param::Metallic, "x").is_err());

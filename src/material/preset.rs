@@ -11,7 +11,8 @@
 //! roughness = 0.25
 //! ```
 //!
-//! Any of the eleven parameters may appear at the top level; those left out take the defaults
+//! Any of the twelve parameters (the eleven of the BRDF, and `emission`) may appear at the top
+//! level; those left out take the defaults
 //! of [`Params::default`]. A metal may also give its complex IOR per channel, `ior_n = [r, g, b]`
 //! and `ior_k = [r, g, b]`, for the `conductor` Fresnel model; its `base_color` must then be their
 //! F0 = ((n−1)² + k²)/((n+1)² + k²), within 0.005. Unknown keys, wrong types, NaN/inf and out-of-range values are
@@ -60,13 +61,14 @@ struct PresetFile {
     sheen_tint: Option<Field>,
     clearcoat: Option<Field>,
     clearcoat_gloss: Option<Field>,
+    emission: Option<Field>,
     ior_n: Option<Field>,
     ior_k: Option<Field>,
 }
 
 impl PresetFile {
     /// The parameter fields, in [`Param::ALL`] order.
-    fn params(&self) -> [(Param, &Option<Field>); 11] {
+    fn params(&self) -> [(Param, &Option<Field>); 12] {
         [
             (Param::BaseColor, &self.base_color),
             (Param::Metallic, &self.metallic),
@@ -79,6 +81,7 @@ impl PresetFile {
             (Param::SheenTint, &self.sheen_tint),
             (Param::Clearcoat, &self.clearcoat),
             (Param::ClearcoatGloss, &self.clearcoat_gloss),
+            (Param::Emission, &self.emission),
         ]
     }
 }

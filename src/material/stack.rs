@@ -1,19 +1,27 @@
 //! Layer stacks in their GPU form: one stack per object id found in the g-buffer, its layers
-//! with their own materials, and the masks they use. `resolve.comp` blends them per pixel; the
-//! CPU [`PackedStacks::resolve_pixel`] mirrors it for tests and for inspecting pixels.
+//! with their own materials and map bindings, and the g-buffer channels (masks and maps) they
+//! use. `resolve.comp` blends them per pixel; the CPU [`PackedStacks::resolve_pixel`] mirrors it
+//! for tests and for inspecting pixels.
 
 use super::look::{Layer, Look, ObjectStack};
-use super::params::Params;
+use super::params::{Param, Params, GPU_FLOATS};
+use crate::gbuffer::{GBuffer, MapSource, MAP_PREFIX, MASK_PREFIX};
 use crate::{Error, Result};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// One layer as `resolve.comp` reads it (std430, 80 bytes).
+/// No channel: a layer without a mask, or a value bound to no map.
+const NONE: i32 = -1;
+
+/// One layer as `resolve.comp` reads it (std430, 176 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GpuLayer {
-    pub params: [f32; 16],
-    /// Index into [`PackedStacks::masks`], or −1 for none (1 everywhere).
+    pub params: [f32; GPU_FLOATS],
+    /// Per value of `params`: the index into [`PackedStacks::channels`] of the map it is
+    /// multiplied by, or −1.
+    pub maps: [i32; GPU_FLOATS],
+    /// Index into [`PackedStacks::channels`], or −1 for none (1 everywhere).
     pub mask: i32,
     pub invert: u32,
     pub opacity: f32,
@@ -23,26 +31,86 @@ pub struct GpuLayer {
 impl GpuLayer {
     /// A lone layer of the default parameters, for objects no stack covers.
     fn default_material() -> GpuLayer {
-        GpuLayer { params: Params::default().to_gpu(), mask: -1, invert: 0, opacity: 1.0, pad: 0 }
+        GpuLayer {
+            params: Params::default().to_gpu(),
+            maps: [NONE; GPU_FLOATS],
+            mask: NONE,
+            invert: 0,
+            opacity: 1.0,
+            pad: 0,
+        }
     }
+
+    /// The layer's material at a pixel whose channel values `channel_value` gives: its own
+    /// values, each one bound to a map multiplied by the map's value.
+    fn material(&self, channel_value: &impl Fn(usize) -> f32) -> Params {
+        let values = std::array::from_fn(|k| match self.maps[k] {
+            NONE => self.params[k],
+            channel => self.params[k] * channel_value(channel as usize),
+        });
+        Params::from_gpu(&values)
+    }
+}
+
+/// The look's name in messages: its file, or "built-in look".
+fn look_name(look: &Look) -> String {
+    look.file.as_deref().map(|p| p.display().to_string()).unwrap_or_else(|| "built-in look".into())
 }
 
 /// Every mask the look names, on any layer of any stack, must be in the g-buffer. Disabled layers
 /// count too, so that enabling one is never what breaks a render.
-fn check_masks(look: &Look, look_name: &str, available: &[String], gbuffer_name: &Path) -> Result<()> {
+fn check_masks(look: &Look, gbuffer: &GBuffer, gbuffer_name: &Path) -> Result<()> {
     for layer in look.objects.iter().flat_map(|o| &o.layers) {
-        let Some(name) = layer.mask.as_ref().filter(|m| !available.contains(m)) else {
+        let Some(name) = layer.mask.as_ref().filter(|m| !gbuffer.masks.contains_key(*m)) else {
             continue;
         };
-        let has = if available.is_empty() {
+        let has = if gbuffer.masks.is_empty() {
             "no masks".to_string()
         } else {
-            available.iter().map(|m| format!("mask.{m}")).collect::<Vec<_>>().join(", ")
+            gbuffer.masks.keys().map(|m| format!("{MASK_PREFIX}{m}")).collect::<Vec<_>>().join(", ")
         };
         return Err(Error::input_file(
-            format!("{look_name}:{}", layer.line),
+            format!("{}:{}", look_name(look), layer.line),
             format!("mask '{name}' is not in the g-buffer {} (it has {has})", gbuffer_name.display()),
         ));
+    }
+    Ok(())
+}
+
+/// The g-buffer channels (without the `map.` prefix) a parameter bound to `map` reads, one per
+/// value of the parameter: three for a colour, where one channel stands for a grey. The error
+/// says what is wrong, naming the g-buffer file and the maps it has.
+fn bound_channels(
+    param: Param,
+    map: &str,
+    gbuffer: &GBuffer,
+    gbuffer_name: &Path,
+) -> std::result::Result<Vec<String>, String> {
+    let values = if param.is_color() { 3 } else { 1 };
+    let file = gbuffer_name.display();
+    match gbuffer.map_source(map) {
+        Some(MapSource::Channel(channel)) => Ok(vec![channel; values]),
+        Some(MapSource::Color(trio)) if param.is_color() => Ok(trio.to_vec()),
+        Some(MapSource::Color(_)) => Err(format!(
+            "map '{map}' of the g-buffer {file} is a colour map, and {param} is a number: bind one channel of it, such as '{map}.G'"
+        )),
+        None => {
+            let names: Vec<String> = gbuffer.maps().into_iter().map(|m| m.name).collect();
+            let candidates: Vec<&str> = names.iter().map(String::as_str).collect();
+            let hint = super::near_miss(map, &candidates).map(|n| format!("; did you mean '{n}'?")).unwrap_or_default();
+            Err(format!("map '{map}' (bound to {param}) is not in the g-buffer {file} (it has {}){hint}", gbuffer.map_list()))
+        }
+    }
+}
+
+/// Every map binding of the look, on any layer of any stack (disabled ones too, as for masks),
+/// must name a map of the g-buffer that fits its parameter.
+fn check_maps(look: &Look, gbuffer: &GBuffer, gbuffer_name: &Path) -> Result<()> {
+    for layer in look.objects.iter().flat_map(|o| &o.layers) {
+        for (&param, map) in &layer.maps {
+            bound_channels(param, map, gbuffer, gbuffer_name)
+                .map_err(|problem| Error::input_file(format!("{}:{}", look_name(look), layer.line), problem))?;
+        }
     }
     Ok(())
 }
@@ -50,7 +118,7 @@ fn check_masks(look: &Look, look_name: &str, available: &[String], gbuffer_name:
 /// Warnings for the look's stacks whose object id is not among `object_ids` (the g-buffer's
 /// shaded objects): those stacks can never show, which is usually a typo in the id.
 pub fn unused_stack_warnings(look: &Look, object_ids: &[u32], gbuffer_name: &Path) -> Vec<String> {
-    let look_name = look.file.as_deref().map(|p| p.display().to_string()).unwrap_or_else(|| "built-in look".into());
+    let look_name = look_name(look);
     look.objects
         .iter()
         .filter_map(|stack| {
@@ -78,8 +146,9 @@ pub struct GpuStack {
 pub struct PackedStacks {
     pub stacks: Vec<GpuStack>,
     pub layers: Vec<GpuLayer>,
-    /// The g-buffer masks the layers use, in the order of the GPU's mask layers.
-    pub masks: Vec<String>,
+    /// The g-buffer channels the layers use, masks and maps by their full channel names
+    /// (`mask.stripes`, `map.baseColor.R`), in the order of the GPU's channel layers.
+    pub channels: Vec<String>,
     /// Object id → index into `stacks`.
     pub stack_of_object: BTreeMap<u32, u32>,
 }
@@ -88,21 +157,21 @@ impl PackedStacks {
     /// Packs the look's stacks for the objects in `object_ids` (those that are shaded). Disabled
     /// layers are left out, so the lowest enabled layer is the one that fills. An object with
     /// neither its own stack nor a default stack, or whose layers are all disabled, gets the
-    /// default parameters. A mask the look names that `available_masks` lacks is an error
-    /// naming both files and the layer's line. Stack 0 always exists, for the pixels that shade
-    /// nothing.
+    /// default parameters. A mask or map the look names that `gbuffer` lacks, or a map that does
+    /// not fit its parameter, is an error naming both files and the layer's line. Stack 0 always
+    /// exists, for the pixels that shade nothing.
     pub fn pack(
         look: &Look,
         object_ids: impl IntoIterator<Item = u32>,
-        available_masks: &[String],
+        gbuffer: &GBuffer,
         gbuffer_name: &Path,
     ) -> Result<PackedStacks> {
-        let look_name = look.file.as_deref().map(|p| p.display().to_string()).unwrap_or_else(|| "built-in look".into());
-        check_masks(look, &look_name, available_masks, gbuffer_name)?;
+        check_masks(look, gbuffer, gbuffer_name)?;
+        check_maps(look, gbuffer, gbuffer_name)?;
         let mut packed = PackedStacks {
             stacks: Vec::new(),
             layers: Vec::new(),
-            masks: Vec::new(),
+            channels: Vec::new(),
             stack_of_object: BTreeMap::new(),
         };
         for id in object_ids {
@@ -112,11 +181,20 @@ impl PackedStacks {
             for (i, layer) in layers.iter().enumerate() {
                 // The bottom layer fills: its mask has no effect.
                 let mask = match &layer.mask {
-                    Some(name) if i > 0 => packed.mask_index(name) as i32,
-                    _ => -1,
+                    Some(name) if i > 0 => packed.channel_index(&format!("{MASK_PREFIX}{name}")),
+                    _ => NONE,
                 };
+                let mut maps = [NONE; GPU_FLOATS];
+                for (&param, map) in &layer.maps {
+                    let channels =
+                        bound_channels(param, map, gbuffer, gbuffer_name).expect("check_maps() checked the maps");
+                    for (k, channel) in channels.iter().enumerate() {
+                        maps[param.gpu_index() + k] = packed.channel_index(&format!("{MAP_PREFIX}{channel}"));
+                    }
+                }
                 packed.layers.push(GpuLayer {
                     params: layer.params.to_gpu(),
+                    maps,
                     mask,
                     invert: layer.invert as u32,
                     opacity: layer.opacity,
@@ -141,26 +219,33 @@ impl PackedStacks {
         Ok(packed)
     }
 
-    /// The GPU mask layer of a g-buffer mask, added on first use.
-    fn mask_index(&mut self, name: &str) -> usize {
-        self.masks.iter().position(|m| m == name).unwrap_or_else(|| {
-            self.masks.push(name.to_string());
-            self.masks.len() - 1
-        })
+    /// The GPU channel layer of a g-buffer channel, added on first use.
+    fn channel_index(&mut self, channel: &str) -> i32 {
+        let index = self.channels.iter().position(|c| c == channel).unwrap_or_else(|| {
+            self.channels.push(channel.to_string());
+            self.channels.len() - 1
+        });
+        index as i32
     }
 
-    /// The blended material of one pixel, as `resolve.comp` computes it; `mask_value(i)` is the
-    /// pixel's value of `masks[i]`.
-    pub fn resolve_pixel(&self, object_id: u32, mask_value: impl Fn(usize) -> f32) -> Params {
+    /// The blended material of one pixel, as `resolve.comp` computes it; `channel_value(i)` is
+    /// the pixel's value of `channels[i]`.
+    pub fn resolve_pixel(&self, object_id: u32, channel_value: impl Fn(usize) -> f32) -> Params {
         let stack = self.stacks[self.stack_of_object[&object_id] as usize];
         let layers = &self.layers[stack.first_layer as usize..(stack.first_layer + stack.layer_count) as usize];
-        let mut params = Params::from_gpu(&layers[0].params);
+        let mut params = layers[0].material(&channel_value);
         for layer in &layers[1..] {
-            let m = if layer.mask >= 0 { mask_value(layer.mask as usize) } else { 1.0 };
+            let m = if layer.mask >= 0 { channel_value(layer.mask as usize) } else { 1.0 };
             let w = (layer.opacity * if layer.invert != 0 { 1.0 - m } else { m }).clamp(0.0, 1.0);
-            params = params.mix(&Params::from_gpu(&layer.params), w);
+            params = params.mix(&layer.material(&channel_value), w);
         }
         params
+    }
+
+    /// [`PackedStacks::resolve_pixel`] at pixel `index` of the g-buffer the stacks were packed for.
+    pub fn resolve_gbuffer_pixel(&self, gbuffer: &GBuffer, index: usize) -> Params {
+        let channel_value = |i: usize| gbuffer.layer_channel(&self.channels[i]).map_or(0.0, |values| values[index]);
+        self.resolve_pixel(gbuffer.object_id[index], channel_value)
     }
 }
 
@@ -204,21 +289,88 @@ mod tests {
 
     fn layer(roughness: f32, mask: Option<&str>, enabled: bool) -> Layer {
         Layer {
-            preset: None,
             params: Params { roughness, ..Params::default() },
-            overrides: Vec::new(),
             mask: mask.map(String::from),
-            invert: false,
             opacity: 0.5,
             enabled,
-            line: 0,
+            ..Layer::filling(Params::default())
         }
     }
 
-    fn pack(layers: Vec<Layer>) -> PackedStacks {
+    /// A one-pixel g-buffer with masks `stripes` and `grunge`, the colour map `tex` and the
+    /// scalar map `rough`.
+    fn gbuffer() -> GBuffer {
+        let mut gbuffer = GBuffer::shaderball(1, 1);
+        gbuffer.object_id = vec![1];
+        gbuffer.masks = [("stripes", 0.8), ("grunge", 0.25)].map(|(n, v)| (n.to_string(), vec![v])).into();
+        gbuffer.maps = [("tex.R", 0.5), ("tex.G", 0.25), ("tex.B", 0.125), ("rough", 0.4)]
+            .map(|(n, v)| (n.to_string(), vec![v]))
+            .into();
+        gbuffer
+    }
+
+    fn look(layers: Vec<Layer>) -> Look {
         let mut look = Look::default_material();
         look.objects = vec![ObjectStack { id: Some(1), layers }];
-        PackedStacks::pack(&look, [1], &["stripes".to_string(), "grunge".to_string()], Path::new("test.exr")).unwrap()
+        look
+    }
+
+    fn pack(layers: Vec<Layer>) -> PackedStacks {
+        PackedStacks::pack(&look(layers), [1], &gbuffer(), Path::new("test.exr")).unwrap()
+    }
+
+    fn pack_error(layers: Vec<Layer>) -> String {
+        PackedStacks::pack(&look(layers), [1], &gbuffer(), Path::new("test.exr")).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn bound_values_are_the_layers_times_the_maps_and_blend_as_before() {
+        let mut bottom = layer(0.5, None, true);
+        bottom.params.base_color = [0.8, 0.6, 1.0];
+        bottom.maps = [(Param::BaseColor, "tex".to_string()), (Param::Roughness, "rough".to_string())].into();
+        let mut top = layer(0.9, Some("stripes"), true);
+        top.params.emission = [2.0, 4.0, 8.0];
+        top.maps = [(Param::Emission, "tex.G".to_string()), (Param::Metallic, "tex.B".to_string())].into();
+        top.params.metallic = 1.0;
+        let packed = pack(vec![bottom, top]);
+        assert_eq!(packed.channels, ["map.tex.R", "map.tex.G", "map.tex.B", "map.rough", "mask.stripes"]);
+        let g = gbuffer();
+        let p = packed.resolve_gbuffer_pixel(&g, 0);
+        let w = 0.5 * 0.8;
+        let mixed = |a: f32, b: f32| a * (1.0 - w) + b * w;
+        assert!(
+            (p.base_color[0] - mixed(0.8 * 0.5, 0.8)).abs() < 1e-6,
+            "the bottom's base colour × map, under the top's"
+        );
+        assert!((p.base_color[2] - mixed(1.0 * 0.125, 0.8)).abs() < 1e-6, "{:?}", p.base_color);
+        assert!((p.roughness - mixed(0.5 * 0.4, 0.9)).abs() < 1e-6, "{}", p.roughness);
+        assert!((p.metallic - mixed(0.0, 0.125)).abs() < 1e-6, "{}", p.metallic);
+        // One channel of a colour map is a grey for a colour parameter.
+        for (c, e) in [2.0f32, 4.0, 8.0].into_iter().enumerate() {
+            assert!((p.emission[c] - mixed(0.0, e * 0.25)).abs() < 1e-6, "{:?}", p.emission);
+        }
+    }
+
+    #[test]
+    fn a_binding_the_gbuffer_cannot_satisfy_is_an_error_naming_what_it_has() {
+        let mut bound = layer(0.5, None, true);
+        bound.line = 7;
+        bound.maps = [(Param::BaseColor, "texx".to_string())].into();
+        let message = pack_error(vec![bound.clone()]);
+        assert!(
+            message.starts_with("built-in look:7: map 'texx' (bound to base_color) is not in the g-buffer test.exr")
+        );
+        assert!(message.contains("(it has map.rough, map.tex.R/G/B); did you mean 'tex'?"), "{message}");
+
+        bound.maps = [(Param::Roughness, "tex".to_string())].into();
+        let message = pack_error(vec![bound.clone()]);
+        assert!(message.contains("is a colour map, and roughness is a number"), "{message}");
+        assert!(message.contains("'tex.G'"), "{message}");
+
+        // A disabled layer's binding is checked too.
+        bound.maps = [(Param::Metallic, "nope".to_string())].into();
+        bound.enabled = false;
+        assert!(pack_error(vec![layer(0.1, None, true), bound]).contains("map 'nope'"));
     }
 
     #[test]
@@ -230,7 +382,7 @@ mod tests {
         let roughness: Vec<f32> = packed.layers.iter().map(|l| Params::from_gpu(&l.params).roughness).collect();
         assert_eq!(roughness, [0.2, 0.3]);
         assert_eq!(packed.layers[0].mask, -1, "the filling layer's mask has no effect");
-        assert_eq!(packed.masks, ["grunge"], "a mask used only as the fill is not bound");
+        assert_eq!(packed.channels, ["mask.grunge"], "a mask used only as the fill is not bound");
         assert_eq!(packed.resolve_pixel(1, |_| 0.0).roughness, 0.2, "the new bottom fills where the mask is 0");
 
         // A disabled layer in the middle simply drops out.
@@ -238,7 +390,7 @@ mod tests {
             pack(vec![layer(0.1, None, true), layer(0.2, Some("stripes"), false), layer(0.3, Some("grunge"), true)]);
         let roughness: Vec<f32> = packed.layers.iter().map(|l| Params::from_gpu(&l.params).roughness).collect();
         assert_eq!(roughness, [0.1, 0.3]);
-        assert_eq!(packed.masks, ["grunge"]);
+        assert_eq!(packed.channels, ["mask.grunge"]);
 
         // Every layer disabled: one layer of the default material.
         let packed = pack(vec![layer(0.1, None, false), layer(0.2, Some("stripes"), false)]);
@@ -265,7 +417,7 @@ mod tests {
         assert!((total - 1.0).abs() < 1e-6, "shares sum to 1, got {total}");
 
         let packed = pack(layers.clone());
-        let resolved = packed.resolve_pixel(1, |i| masks(&packed.masks[i])).roughness;
+        let resolved = packed.resolve_pixel(1, |i| masks(&packed.channels[i]["mask.".len()..])).roughness;
         let enabled: Vec<&Layer> = layers.iter().filter(|l| l.enabled).collect();
         let shared: f32 = enabled.iter().zip(&w).map(|(l, w)| l.params.roughness * w.contribution).sum();
         assert!((resolved - shared).abs() < 1e-6, "resolve gives {resolved}, the shares {shared}");

@@ -177,31 +177,39 @@ pub(crate) fn unknown(noun: &str, key: &str, place: &str, expected: &[&str]) -> 
 /// The candidate closest to `name`, if it is within two edits or a third of its length.
 pub(crate) fn near_miss<'a>(name: &str, candidates: &[&'a str]) -> Option<&'a str> {
     let limit = (name.chars().count() / 3).max(2);
-    closest(name, candidates.iter().copied()).into_iter().next().filter(|c| levenshtein(name, c) <= limit)
+    closest(name, candidates.iter().copied()).into_iter().next().filter(|c| edit_distance(name, c) <= limit)
 }
 
 /// All candidates, closest to `name` first (ties in alphabetical order).
 pub(crate) fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Vec<&'a str> {
-    let mut ranked: Vec<(usize, &str)> = candidates.into_iter().map(|c| (levenshtein(name, c), c)).collect();
+    let mut ranked: Vec<(usize, &str)> = candidates.into_iter().map(|c| (edit_distance(name, c), c)).collect();
     ranked.sort();
     ranked.dedup();
     ranked.into_iter().map(|(_, c)| c).collect()
 }
 
-/// Edit distance: the fewest single-character insertions, deletions and substitutions.
-pub(crate) fn levenshtein(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    // previous[j] is the distance between the first i-1 characters of a and the first j of b.
-    let mut previous: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut current = vec![i + 1; b.len() + 1];
-        for (j, &cb) in b.iter().enumerate() {
-            let substitute = previous[j] + usize::from(ca != cb);
-            current[j + 1] = substitute.min(previous[j + 1] + 1).min(current[j] + 1);
-        }
-        previous = current;
+/// Edit distance: the fewest single-character insertions, deletions, substitutions and swaps of
+/// two neighbours (optimal string alignment), so that the common typo "maks" is one edit from
+/// "mask".
+pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
+    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+    // d[i][j] is the distance between the first i characters of a and the first j of b.
+    let mut d = vec![vec![0usize; b.len() + 1]; a.len() + 1];
+    for (i, row) in d.iter_mut().enumerate() {
+        row[0] = i;
     }
-    previous[b.len()]
+    d[0] = (0..=b.len()).collect();
+    for i in 1..=a.len() {
+        for j in 1..=b.len() {
+            let substitute = d[i - 1][j - 1] + usize::from(a[i - 1] != b[j - 1]);
+            let mut best = substitute.min(d[i - 1][j] + 1).min(d[i][j - 1] + 1);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                best = best.min(d[i - 2][j - 2] + 1);
+            }
+            d[i][j] = best;
+        }
+    }
+    d[a.len()][b.len()]
 }
 
 /// Reads a whole file, saying plainly when it is missing.
@@ -337,13 +345,15 @@ mod tests {
     use super::*;
 
     #[test]
-    fn edit_distance() {
-        assert_eq!(levenshtein("", ""), 0);
-        assert_eq!(levenshtein("gold", "gold"), 0);
-        assert_eq!(levenshtein("golld", "gold"), 1);
-        assert_eq!(levenshtein("sppp", "spp"), 1);
-        assert_eq!(levenshtein("kitten", "sitting"), 3);
-        assert_eq!(levenshtein("", "abc"), 3);
+    fn edit_distances() {
+        assert_eq!(edit_distance("", ""), 0);
+        assert_eq!(edit_distance("gold", "gold"), 0);
+        assert_eq!(edit_distance("golld", "gold"), 1);
+        assert_eq!(edit_distance("sppp", "spp"), 1);
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(edit_distance("maks", "mask"), 1, "a swap of neighbours is one edit");
+        assert_eq!(edit_distance("maks", "map"), 2);
     }
 
     #[test]

@@ -42,8 +42,7 @@ impl<'a> Batch<'a> {
     /// Renders `look` with `settings` (environment file excepted: the batch's is fixed) to
     /// `settings.spp`, calling `progress(samples)` after each pass.
     pub fn render(&mut self, look: &Look, settings: &Settings, progress: impl FnMut(u32)) -> Result<()> {
-        let masks: Vec<String> = self.gbuffer.masks.keys().cloned().collect();
-        let stacks = PackedStacks::pack(look, covered_object_ids(self.gbuffer), &masks, self.gbuffer_name)?;
+        let stacks = PackedStacks::pack(look, covered_object_ids(self.gbuffer), self.gbuffer, self.gbuffer_name)?;
         self.renderer.set_stacks(&stacks)?;
         self.renderer.set_model(&settings.model)?;
         self.renderer.set_lighting(settings.lighting);

@@ -2,7 +2,7 @@
 //! relight passes, and display transforms. Every command that renders drives it.
 
 use crate::environment::{self, Distribution, Environment, GpuEnvironment};
-use crate::gbuffer::GBuffer;
+use crate::gbuffer::{GBuffer, MAP_PREFIX, MASK_PREFIX};
 use crate::gpu::pipeline::group_count;
 use crate::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, GpuTimer, Image};
 use crate::material::stack::PackedStacks;
@@ -12,6 +12,7 @@ use crate::shading::energy::EnergyTable;
 use crate::shading::model::Model;
 use crate::Result;
 use ash::vk;
+use std::collections::BTreeMap;
 use std::sync::Arc;
 
 /// Workgroup size of the 2D kernels (`local_size_x`, `local_size_y` in glsl/*.comp).
@@ -60,11 +61,12 @@ struct FinalizePush {
     end_row: u32,
 }
 
-/// The per-object material inputs on the GPU: which stack each pixel uses, the layers, the masks.
-/// Held only to keep them alive while the resolve set points at them.
+/// The per-object material inputs on the GPU: which stack each pixel uses, the layers, and the
+/// mask and map channels they read. Held only to keep them alive while the resolve set points at
+/// them.
 struct GpuStacks {
     _stack_index: Image,
-    _masks: Image,
+    _channels: Image,
     _stacks: Buffer,
     _layers: Buffer,
     _set: DescriptorSet,
@@ -89,7 +91,8 @@ pub struct Renderer {
     radiance: Image,
     display: Image,
     object_ids: Vec<u32>,
-    masks: Vec<(String, Vec<f32>)>,
+    /// The g-buffer's masks and maps by full channel name, for the stacks to choose from.
+    channels: BTreeMap<String, Vec<f32>>,
     stacks: Option<GpuStacks>,
     _environment: GpuEnvironment,
     environment_set: DescriptorSet,
@@ -100,6 +103,16 @@ pub struct Renderer {
     seed: u32,
     /// Samples each row has in the current accumulation.
     row_samples: Vec<u32>,
+}
+
+/// The resolved material's layers: the five vec4s of `Params::to_gpu`.
+pub const RESOLVED_LAYERS: u32 = (crate::material::params::GPU_FLOATS / 4) as u32;
+
+/// The g-buffer's masks and maps, keyed by their full channel names as packed stacks name them.
+fn layer_channels(gbuffer: &GBuffer) -> BTreeMap<String, Vec<f32>> {
+    let masks = gbuffer.masks.iter().map(|(name, values)| (format!("{MASK_PREFIX}{name}"), values.clone()));
+    let maps = gbuffer.maps.iter().map(|(name, values)| (format!("{MAP_PREFIX}{name}"), values.clone()));
+    masks.chain(maps).collect()
 }
 
 fn float_image(ctx: &Context, width: u32, height: u32, layers: u32, data: &[[f32; 4]]) -> Result<Image> {
@@ -151,7 +164,7 @@ impl Renderer {
         surface_data.extend(gbuffer.view.iter().map(|v| [v[0], v[1], v[2], 0.0]));
         surface_data.extend(gbuffer.tangent.iter().map(|t| [t[0], t[1], t[2], 0.0]));
         let surface = float_image(ctx, width, height, 3, &surface_data)?;
-        let resolved = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 4, true)?;
+        let resolved = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, RESOLVED_LAYERS, true)?;
         let float_target = || Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 1, false);
         let accumulation = float_target()?;
         let background = float_target()?;
@@ -198,7 +211,7 @@ impl Renderer {
             radiance,
             display,
             object_ids: gbuffer.object_id.clone(),
-            masks: gbuffer.masks.iter().map(|(k, v)| (k.clone(), v.clone())).collect(),
+            channels: layer_channels(gbuffer),
             stacks: None,
             _environment: gpu_environment,
             environment_set,
@@ -303,22 +316,22 @@ impl Renderer {
             self.object_ids.iter().map(|id| packed.stack_of_object.get(id).copied().unwrap_or(0)).collect();
         let stack_index = Image::new(ctx, vk::Format::R32_UINT, width, height, 1, false)?;
         stack_index.upload(ctx, bytemuck::cast_slice(&index))?;
-        // At least one mask layer, so the binding is always valid.
-        let layers = packed.masks.len().max(1) as u32;
-        let mut mask_data = vec![0.0f32; pixels * layers as usize];
-        for (i, name) in packed.masks.iter().enumerate() {
-            let (_, values) = self.masks.iter().find(|(n, _)| n == name).expect("pack() checked the masks");
-            mask_data[i * pixels..(i + 1) * pixels].copy_from_slice(values);
+        // At least one channel layer, so the binding is always valid.
+        let layers = packed.channels.len().max(1) as u32;
+        let mut channel_data = vec![0.0f32; pixels * layers as usize];
+        for (i, name) in packed.channels.iter().enumerate() {
+            let values = self.channels.get(name).expect("pack() checked the masks and maps");
+            channel_data[i * pixels..(i + 1) * pixels].copy_from_slice(values);
         }
-        let masks = Image::new(ctx, vk::Format::R32_SFLOAT, width, height, layers, true)?;
-        masks.upload(ctx, bytemuck::cast_slice(&mask_data))?;
+        let channels = Image::new(ctx, vk::Format::R32_SFLOAT, width, height, layers, true)?;
+        channels.upload(ctx, bytemuck::cast_slice(&channel_data))?;
         let stacks = Buffer::with_data(ctx, bytemuck::cast_slice(&packed.stacks))?;
         let layer_buffer = Buffer::with_data(ctx, bytemuck::cast_slice(&packed.layers))?;
         let set = self.resolve.bind(
             0,
             &[
                 Binding::Image(&stack_index),
-                Binding::Image(&masks),
+                Binding::Image(&channels),
                 Binding::Buffer(&stacks),
                 Binding::Buffer(&layer_buffer),
                 Binding::Image(&self.resolved),
@@ -328,7 +341,7 @@ impl Renderer {
         self.timed(|renderer, cmd| renderer.resolve.dispatch(cmd, &[&set], &[], groups))?;
         self.stacks = Some(GpuStacks {
             _stack_index: stack_index,
-            _masks: masks,
+            _channels: channels,
             _stacks: stacks,
             _layers: layer_buffer,
             _set: set,
@@ -482,7 +495,8 @@ impl Renderer {
         Ok(staging.bytes()[..self.display.byte_size() as usize].to_vec())
     }
 
-    /// The resolved material per pixel, as four layers of vec4 (for tests and inspection).
+    /// The resolved material per pixel, as [`RESOLVED_LAYERS`] layers of vec4 in the layout of
+    /// [`crate::material::Params::to_gpu`] (for tests and inspection).
     pub fn read_resolved(&self) -> Result<Vec<[f32; 4]>> {
         Ok(bytemuck::cast_slice(&self.resolved.read(&self.ctx)?).to_vec())
     }

@@ -32,9 +32,8 @@ impl Scene {
         environment: Environment,
         settings: Settings,
     ) -> Result<Scene> {
-        let available: Vec<String> = gbuffer.masks.keys().cloned().collect();
         let covered = covered_object_ids(&gbuffer);
-        let stacks = PackedStacks::pack(&look, covered.iter().copied(), &available, &gbuffer_name)?;
+        let stacks = PackedStacks::pack(&look, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
         unused_stack_warnings(&look, &covered, &gbuffer_name).into_iter().for_each(crate::warn);
         Ok(Scene { gbuffer, gbuffer_name, look, environment, settings, stacks })
     }
@@ -96,10 +95,10 @@ impl Scene {
                 format!("the g-buffer is {w}x{h}, larger than {}'s {max}-pixel image limit", info.name),
             ));
         }
-        if self.stacks.masks.len() as u32 > info.max_image_array_layers {
+        if self.stacks.channels.len() as u32 > info.max_image_array_layers {
             return Err(crate::Error::input(format!(
-                "the look uses {} masks, more than {}'s {} image layers",
-                self.stacks.masks.len(),
+                "the look uses {} mask and map channels, more than {}'s {} image layers",
+                self.stacks.channels.len(),
                 info.name,
                 info.max_image_array_layers
             )));

@@ -75,14 +75,13 @@ impl Inputs {
             None => Environment::studio(),
         };
         let covered = covered_object_ids(&gbuffer);
-        let masks: Vec<String> = gbuffer.masks.keys().cloned().collect();
-        PackedStacks::pack(&look, covered.iter().copied(), &masks, &gbuffer_name)?;
+        PackedStacks::pack(&look, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
         unused_stack_warnings(&look, &covered, &gbuffer_name).into_iter().for_each(crate::warn);
         // B's inputs are checked here too, so that a bad one is an error before a window opens.
         model_with(settings.model, &options.compare_model, "--compare-model")?;
         if let Some(path) = &options.compare_look {
             let b = Look::load(path)?;
-            PackedStacks::pack(&b, covered.iter().copied(), &masks, &gbuffer_name)?;
+            PackedStacks::pack(&b, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
         }
         let mut document = Document::new(look, options.look.clone(), settings);
         document.select(initial_selection(&document, &covered));

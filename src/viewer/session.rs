@@ -122,7 +122,7 @@ impl Session {
     ) -> Result<Session> {
         let objects = covered_object_ids(&gbuffer);
         let masks: Vec<String> = gbuffer.masks.keys().cloned().collect();
-        let packed = PackedStacks::pack(document.look(), objects.iter().copied(), &masks, &gbuffer_name)?;
+        let packed = PackedStacks::pack(document.look(), objects.iter().copied(), &gbuffer, &gbuffer_name)?;
         let settings = document.settings().clone();
         let mut renderer = Renderer::with_model(ctx, &gbuffer, &environment, &settings.model)?;
         renderer.set_stacks(&packed)?;
@@ -246,7 +246,7 @@ impl Session {
     /// that does not load or fit the g-buffer changes nothing.
     pub fn compare_look(&mut self, path: &Path) -> Result<()> {
         let look = crate::material::Look::load(path)?;
-        let packed = PackedStacks::pack(&look, self.objects.iter().copied(), &self.masks, &self.gbuffer_name)?;
+        let packed = PackedStacks::pack(&look, self.objects.iter().copied(), &self.gbuffer, &self.gbuffer_name)?;
         crate::material::stack::unused_stack_warnings(&look, &self.objects, &self.gbuffer_name)
             .into_iter()
             .for_each(crate::warn);
@@ -348,7 +348,7 @@ impl Session {
             let packed = PackedStacks::pack(
                 self.document.look(),
                 self.objects.iter().copied(),
-                &self.masks,
+                &self.gbuffer,
                 &self.gbuffer_name,
             )?;
             if everything || packed != self.packed {
@@ -480,11 +480,7 @@ impl Session {
             }
             None => Vec::new(),
         };
-        let params = if shaded {
-            self.packed.resolve_pixel(object_id, |i| mask_value(&self.packed.masks[i]))
-        } else {
-            Params::default()
-        };
+        let params = if shaded { self.packed.resolve_gbuffer_pixel(&self.gbuffer, index) } else { Params::default() };
         let settings = self.document.settings();
         let radiance = if self.samples() > 0 {
             self.renderer.read_radiance_pixel(x, y, settings.exposure, settings.tonemap)?
@@ -510,7 +506,7 @@ impl Session {
     /// Replaces the document (another look was opened) and everything shown of it. On error
     /// (the look's masks or environment do not fit), the old document stays.
     pub fn replace_document(&mut self, document: Document) -> Result<()> {
-        PackedStacks::pack(document.look(), self.objects.iter().copied(), &self.masks, &self.gbuffer_name)?;
+        PackedStacks::pack(document.look(), self.objects.iter().copied(), &self.gbuffer, &self.gbuffer_name)?;
         self.load_environment(document.settings().environment.as_deref())?;
         self.document = document;
         self.inspection = None;

@@ -127,9 +127,12 @@ impl Thumbnails {
             None => self.renderer.insert(Renderer::new(&self.ctx, &self.gbuffer, &Environment::studio())?),
         };
         let look = preset_on_ball(params);
-        let masks: Vec<String> = self.gbuffer.masks.keys().cloned().collect();
-        let stacks =
-            PackedStacks::pack(&look, covered_object_ids(&self.gbuffer), &masks, Path::new("built-in shader ball"))?;
+        let stacks = PackedStacks::pack(
+            &look,
+            covered_object_ids(&self.gbuffer),
+            &self.gbuffer,
+            Path::new("built-in shader ball"),
+        )?;
         renderer.set_stacks(&stacks)?;
         renderer.set_lighting(self.settings.lighting);
         renderer.set_seed(self.settings.seed);

@@ -71,8 +71,9 @@ impl Reference<'_> {
             let t = texel_of(self.env.width, self.env.height, direction_to_uv(d));
             (Vec3::from(self.env.texel(t.x, t.y)), self.distribution.texel_cell_pdf(t))
         };
+        let emission = Vec3::from(params.emission);
         if v.z <= 0.0 {
-            return sum;
+            return (0..spp).fold(sum, |sum, _| sum + emission);
         }
         for s in 0..spp {
             let mut radiance = Vec3::ZERO;
@@ -97,7 +98,7 @@ impl Reference<'_> {
                     radiance += f * (l.z * mis_weight_over_pdf(pdf_brdf, pdf_env)) * le;
                 }
             }
-            sum += radiance * self.lighting.intensity;
+            sum += emission + radiance * self.lighting.intensity;
         }
         sum
     }

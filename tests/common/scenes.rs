@@ -35,8 +35,7 @@ pub fn orthographic_sphere(size: u32) -> GBuffer {
 /// A renderer for a g-buffer, environment and look, with stacks resolved and lighting set.
 pub fn renderer(ctx: &Context, gbuffer: &GBuffer, env: &Environment, look: &Look, lighting: Lighting) -> Renderer {
     let ids = lookdev::render::scene::covered_object_ids(gbuffer);
-    let masks: Vec<String> = gbuffer.masks.keys().cloned().collect();
-    let stacks = PackedStacks::pack(look, ids, &masks, Path::new("test g-buffer")).unwrap();
+    let stacks = PackedStacks::pack(look, ids, gbuffer, Path::new("test g-buffer")).unwrap();
     let mut renderer = Renderer::new(ctx, gbuffer, env).unwrap();
     renderer.set_stacks(&stacks).unwrap();
     renderer.set_lighting(lighting);
