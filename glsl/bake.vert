@@ -1,9 +1,11 @@
 #version 460
 // The bake's vertex stage: world-space vertices (flattened and transformed on the CPU) to clip
-// space. Everything else passes through to the fragment stage.
+// space, and each texture slot's texcoords (KHR_texture_transform applied). Everything else passes
+// through to the fragment stage.
 #extension GL_GOOGLE_include_directive : require
 
 #include "bake_draw.glsl"
+#include "bake_material.glsl"
 
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
@@ -15,16 +17,16 @@ layout(location = 5) in vec4 color;       // COLOR_0, or white
 layout(location = 0) out vec3 world_position;
 layout(location = 1) out vec3 world_normal;
 layout(location = 2) out vec4 world_tangent;
-layout(location = 3) out vec2 out_uv0;
-layout(location = 4) out vec2 out_uv1;
-layout(location = 5) out vec4 out_color;
+layout(location = 3) out vec4 out_color;
+layout(location = SLOT_TEXCOORDS) out vec2 slot_uv[SLOTS];
 
 void main() {
     world_position = position;
     world_normal = normal;
     world_tangent = tangent;
-    out_uv0 = uv0;
-    out_uv1 = uv1;
     out_color = color;
+    for (uint slot = 0u; slot < SLOTS; slot++) {
+        slot_uv[slot] = slot_texcoord(slot, uv0, uv1);
+    }
     gl_Position = draw.view_projection * vec4(position, 1.0);
 }

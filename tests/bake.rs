@@ -289,7 +289,7 @@ fn srgb_to_linear(c: u8) -> f32 {
 }
 
 #[test]
-fn vertex_colours_and_textures_become_masks_and_layers_that_reproduce_every_texel() {
+fn vertex_colours_and_textures_become_masks_and_maps_that_the_look_binds() {
     let dir = tempfile::tempdir().unwrap();
     let mut gltf = Gltf::new();
     // Left half metallic 1 and roughness 0.2, right half metallic 0 and roughness 1 (B and G);
@@ -333,24 +333,27 @@ fn vertex_colours_and_textures_become_masks_and_layers_that_reproduce_every_texe
     assert!((at("color0.b", 32, 62) - 1.0).abs() < 0.05 && (at("color0.a", 32, 62) - 0.5).abs() < 0.05);
     assert!((at("color0.r", 32, 32) - 0.5).abs() < 0.05, "colours interpolate");
 
-    // The texture's raw values, and the look's layers through the corner masks.
+    // The maps hold the texels (the base colour's times COLOR_0), and the imported look's
+    // preset holds the factors: resolved, each pixel has factor × texture.
     let asset = Asset::load(&path).unwrap();
     let import = Import::new(&asset).unwrap();
     let look = import.look(&dir.path().join("worn.toml"), str::to_string);
-    assert_eq!(look.objects[0].layers.len(), 8, "the material and the seven other corners of its three axes");
-    let stack = &look.objects[0];
+    assert_eq!(look.objects[0].layers.len(), 1, "one material, one layer");
+    let maps: Vec<&str> = g.maps.keys().map(String::as_str).collect();
+    assert_eq!(maps, ["base_color.B", "base_color.G", "base_color.R", "metallic", "roughness"]);
+    let ids = lookdev::render::scene::covered_object_ids(&g);
+    let stacks = lookdev::material::stack::PackedStacks::pack(&look, ids, &g, Path::new("worn.exr")).unwrap();
     for (x, texel) in [(16usize, 0usize), (48, 1)] {
         let (m, r) = if texel == 0 { (1.0, 0.2) } else { (0.0, 1.0) };
-        assert!((at("worn.metallic", x, 32) - m).abs() < 0.01, "metallic at x = {x}");
-        assert!((at("worn.roughness", x, 32) - r).abs() < 0.01, "roughness at x = {x}");
-        let weights = lookdev::material::stack::layer_weights(stack, |name| at(name, x, 32));
-        let mut blended = stack.layers[0].params;
-        for (layer, weight) in stack.layers.iter().zip(weights).skip(1) {
-            blended = blended.mix(&layer.params, weight.unwrap().blend);
-        }
+        let i = 32 * 64 + x;
+        assert!((g.maps["metallic"][i] - m).abs() < 0.01, "metallic at x = {x}");
+        assert!((g.maps["roughness"][i] - r).abs() < 0.01, "roughness at x = {x}");
+        let blended = stacks.resolve_gbuffer_pixel(&g, i);
         assert!((blended.metallic - m).abs() < 0.01, "metallic at x = {x}: {}", blended.metallic);
         assert!((blended.roughness - 0.9 * r).abs() < 0.01, "roughness at x = {x}: {}", blended.roughness);
-        let expected = [0, 1, 2].map(|k| factor[k] * srgb_to_linear(colors[texel][k]));
+        // Half way down, COLOR_0 is (0.5, 0, 0.5).
+        let color0 = [0.5, 0.0, 0.5];
+        let expected = [0, 1, 2].map(|k| factor[k] * srgb_to_linear(colors[texel][k]) * color0[k]);
         for k in 0..3 {
             assert!(
                 (blended.base_color[k] - expected[k]).abs() < 0.01,

@@ -1,15 +1,19 @@
 //! Baking: an asset rasterized into a g-buffer (README: lookdev bake).
 //!
 //! Each of `samples` passes draws the whole scene with the camera nudged by a sub-pixel offset
-//! (a stratified pattern), and reads back one sample per pixel of every output. The passes are
-//! then averaged on the CPU, as the built-in scene's subsamples are: coverage is the fraction of
-//! samples that hit, normals, tangents and view vectors are averaged over the hits, the object
-//! ID is the one most samples saw, and each mask is the fraction (or mean value) of the samples
-//! that carry it.
+//! (a stratified pattern), and reads back one sample per pixel of every output. A pass draws
+//! twice when a material has textures that drive parameters: once for the geometry (normals,
+//! tangents, view vectors, ids, `COLOR_0`), then again for the maps (README: lookdev bake), each
+//! of whose samples names its material. The passes are averaged on the CPU, as the built-in scene's
+//! subsamples are: coverage is the fraction of samples that hit, normals, tangents and view
+//! vectors are averaged over the hits, the object ID is the one most samples saw, each mask is
+//! the fraction (or mean value) of the samples that carry it, and each map the mean over the
+//! samples of the materials that write it.
 
 use super::camera::{self, Camera, CameraChoice};
 use super::geometry::{self, Geometry, Vertex};
-use super::materials::{self, material_of, Axis, UsedMaterial};
+use super::materials::{self, material_of, MapKind, UsedMaterial, MAP_CHANNELS};
+use super::textures::{self, Slot, SLOTS};
 use super::Asset;
 use crate::gbuffer::stable_tangent;
 use crate::gbuffer::GBuffer;
@@ -42,40 +46,51 @@ struct DrawConstants {
     toward_eye: [f32; 4],
     object_id: u32,
     material: u32,
+}
+
+/// `TextureSlot` in glsl/include/bake_material.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuTextureSlot {
+    u: [f32; 4],
+    v: [f32; 4],
+    tex_coord: u32,
+    present: u32,
+    pad: [u32; 2],
+}
+
+/// `Material` in glsl/include/bake_material.glsl (std430, 512 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuMaterial {
     flags: u32,
+    maps: u32,
     normal_scale: f32,
-    uv_sets: u32,
     alpha_cutoff: f32,
     anisotropy_cos: f32,
     anisotropy_sin: f32,
+    clearcoat_roughness: f32,
+    pad: f32,
+    base_color_factor: [f32; 4],
+    sheen_color_factor: [f32; 4],
+    specular_color_factor: [f32; 4],
+    slots: [GpuTextureSlot; SLOTS],
 }
 
-const DRAW_DOUBLE_SIDED: u32 = 1;
-const DRAW_NORMAL_MAP: u32 = 2;
-const DRAW_METAL_ROUGH_MAP: u32 = 4;
-const DRAW_ALPHA_MASK: u32 = 8;
-const DRAW_BASE_COLOR_MAP: u32 = 16;
+const MATERIAL_DOUBLE_SIDED: u32 = 1;
+const MATERIAL_ALPHA_MASK: u32 = 2;
 
-/// The render targets, in the fragment shader's output order, with their formats.
-const TARGETS: [vk::Format; 7] = [
+/// The geometry pass's render targets, in bake.frag's output order, with their formats.
+const GEOMETRY_TARGETS: [vk::Format; 5] = [
     vk::Format::R32G32B32A32_SFLOAT, // normal, w = covered
     vk::Format::R32G32B32A32_SFLOAT, // tangent, w = bitangent sign
     vk::Format::R32G32B32A32_SFLOAT, // view
     vk::Format::R32G32_UINT,         // object id, material + 1
     vk::Format::R32G32B32A32_SFLOAT, // COLOR_0
-    vk::Format::R32G32_SFLOAT,       // metallic, roughness texture values
-    vk::Format::R32G32B32A32_SFLOAT, // base colour texture, linear
 ];
 
-/// A material as the fragment shader sees it: its constants and its textures.
-struct GpuMaterial {
-    flags: u32,
-    normal_scale: f32,
-    uv_sets: u32,
-    alpha_cutoff: f32,
-    anisotropy: (f32, f32),
-    set: TextureSet,
-}
+/// The maps pass's render targets (bake_maps.frag), which [`MAP_CHANNELS`] lays out.
+const MAP_TARGETS: [vk::Format; 4] = [vk::Format::R32G32B32A32_SFLOAT; 4];
 
 /// The steps of a bake, for progress reports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -114,17 +129,28 @@ pub fn bake(
     }
     let camera = camera::choose(asset, &options.camera, geometry.bounds, width, height)?;
     let used = materials::used(asset, geometry.draws.iter().map(|d| d.material));
-
-    if ctx.info().max_color_attachments < TARGETS.len() as u32 {
+    for warning in asset.unread_texcoords() {
+        crate::warn(format!("{}: {warning}", asset.path.display()));
+    }
+    // The map kinds of each used material: a base colour map where its primitives carry COLOR_0.
+    let kinds: Vec<Vec<MapKind>> = used
+        .iter()
+        .map(|m| {
+            let colored = geometry.draws.iter().any(|d| d.material == m.index && d.has_colors);
+            materials::map_kinds(&material_of(asset, m.index), colored)
+        })
+        .collect();
+    let with_maps = kinds.iter().any(|k| !k.is_empty());
+    let targets = if with_maps { GEOMETRY_TARGETS.len().max(MAP_TARGETS.len()) } else { GEOMETRY_TARGETS.len() };
+    if ctx.info().max_color_attachments < targets as u32 {
         return Err(Error::gpu(format!(
-            "{} draws to {} colour targets at once, and the bake writes {}",
+            "{} draws to {} colour targets at once, and the bake writes {targets}",
             ctx.info().name,
             ctx.info().max_color_attachments,
-            TARGETS.len()
         )));
     }
-    let rasterizer = Rasterizer::new(ctx, asset, &geometry, &used, width, height)?;
-    let mut accumulator = Accumulator::new(width, height, &used, asset, &geometry);
+    let rasterizer = Rasterizer::new(ctx, asset, &geometry, &used, &kinds, width, height)?;
+    let mut accumulator = Accumulator::new(width, height, &kinds, &geometry);
     for (pass, offset) in jitter_pattern(options.samples).into_iter().enumerate() {
         let samples = rasterizer.pass(&geometry, &camera, offset)?;
         accumulator.add(&samples);
@@ -163,22 +189,30 @@ fn gcd(a: u32, b: u32) -> u32 {
     }
 }
 
-/// The GPU side of a bake: the pipeline, the scene's vertices and textures, and the targets.
+/// The GPU side of a bake: the pipelines, the scene's vertices, materials and textures, and the
+/// targets.
 struct Rasterizer {
     ctx: Context,
     width: u32,
     height: u32,
-    pipeline: GraphicsPipeline,
+    geometry_pipeline: GraphicsPipeline,
+    /// The maps pass, when any material has maps.
+    maps_pipeline: Option<GraphicsPipeline>,
     vertices: Buffer,
-    materials: Vec<GpuMaterial>,
-    /// A draw's glTF material index to its place in `materials`.
+    /// Per used material: its textures for the geometry pass and for the maps pass.
+    sets: Vec<(TextureSet, Option<TextureSet>)>,
+    /// Per used material: whether its back faces are drawn.
+    double_sided: Vec<bool>,
+    /// A draw's glTF material index to its place among the used materials.
     slot_of: HashMap<Option<usize>, usize>,
+    /// The geometry targets, then the maps targets.
     targets: Vec<Image>,
     depth: Image,
     staging: Buffer,
     /// Where each target's copy starts in `staging`.
     offsets: Vec<u64>,
-    // Held so the texture sets' images and samplers stay alive.
+    // Held so the texture sets' buffer, images and samplers stay alive.
+    _materials: Buffer,
     _textures: Vec<Image>,
     _samplers: Vec<Sampler>,
 }
@@ -190,8 +224,97 @@ struct Samples<'a> {
     view: &'a [[f32; 4]],
     ids: &'a [[u32; 2]],
     color: &'a [[f32; 4]],
-    metal_rough: &'a [[f32; 2]],
-    base_color: &'a [[f32; 4]],
+    /// The maps pass's targets, when it ran.
+    maps: Vec<&'a [[f32; 4]]>,
+}
+
+/// The sampler a glTF texture asks for: its filters and wrap modes, with mip mapping unless its
+/// minification filter rules it out. glTF leaves an unset filter to the viewer: linear, and
+/// trilinear between mip levels.
+fn sampler_desc(sampler: &gltf::texture::Sampler) -> SamplerDesc {
+    use gltf::texture::{MagFilter, MinFilter, WrappingMode};
+    let wrap = |mode: WrappingMode| match mode {
+        WrappingMode::ClampToEdge => vk::SamplerAddressMode::CLAMP_TO_EDGE,
+        WrappingMode::MirroredRepeat => vk::SamplerAddressMode::MIRRORED_REPEAT,
+        WrappingMode::Repeat => vk::SamplerAddressMode::REPEAT,
+    };
+    let magnify = match sampler.mag_filter() {
+        Some(MagFilter::Nearest) => vk::Filter::NEAREST,
+        _ => vk::Filter::LINEAR,
+    };
+    let (minify, mipmap) = match sampler.min_filter() {
+        Some(MinFilter::Nearest) => (vk::Filter::NEAREST, None),
+        Some(MinFilter::Linear) => (vk::Filter::LINEAR, None),
+        Some(MinFilter::NearestMipmapNearest) => (vk::Filter::NEAREST, Some(vk::SamplerMipmapMode::NEAREST)),
+        Some(MinFilter::LinearMipmapNearest) => (vk::Filter::LINEAR, Some(vk::SamplerMipmapMode::NEAREST)),
+        Some(MinFilter::NearestMipmapLinear) => (vk::Filter::NEAREST, Some(vk::SamplerMipmapMode::LINEAR)),
+        Some(MinFilter::LinearMipmapLinear) | None => (vk::Filter::LINEAR, Some(vk::SamplerMipmapMode::LINEAR)),
+    };
+    SamplerDesc { magnify, minify, mipmap, wrap_u: wrap(sampler.wrap_s()), wrap_v: wrap(sampler.wrap_t()) }
+}
+
+/// The GPU's view of one material: its constants and where each slot samples.
+fn gpu_material(
+    material: &gltf::Material,
+    kinds: &[MapKind],
+    references: &[Option<textures::TextureRef>],
+) -> GpuMaterial {
+    let pbr = material.pbr_metallic_roughness();
+    let mut flags = 0;
+    if material.double_sided() {
+        flags |= MATERIAL_DOUBLE_SIDED;
+    }
+    if material.alpha_mode() == gltf::material::AlphaMode::Mask {
+        flags |= MATERIAL_ALPHA_MASK;
+    }
+    let rotation = materials::anisotropy(material).map_or(0.0, |a| a.rotation);
+    let extension_color = |extension: &str, key: &str, default: [f32; 3]| -> [f32; 4] {
+        let color = material
+            .extension_value(extension)
+            .and_then(|e| e.get(key))
+            .and_then(|v| v.as_array())
+            .map(|a| [0, 1, 2].map(|k| a.get(k).and_then(|c| c.as_f64()).unwrap_or(0.0) as f32))
+            .unwrap_or(default);
+        [color[0], color[1], color[2], 0.0]
+    };
+    let factor = pbr.base_color_factor();
+    let mut slots = [GpuTextureSlot::default(); SLOTS];
+    for (slot, reference) in slots.iter_mut().zip(references) {
+        if let Some(r) = reference {
+            let [row0, row1] = r.transform;
+            *slot = GpuTextureSlot {
+                u: [row0[0], row0[1], row0[2], 0.0],
+                v: [row1[0], row1[1], row1[2], 0.0],
+                // Sets beyond TEXCOORD_1 are not read; they were reported, and sample set 0.
+                tex_coord: if r.tex_coord == 1 { 1 } else { 0 },
+                present: 1,
+                pad: [0; 2],
+            };
+        }
+    }
+    GpuMaterial {
+        flags,
+        maps: kinds.iter().map(|k| k.bit()).sum(),
+        normal_scale: material.normal_texture().map_or(1.0, |t| t.scale()),
+        // The shader compares COLOR_0's alpha times the texture's; dividing the cutoff by the
+        // factor's alpha brings that in too.
+        alpha_cutoff: match factor[3] {
+            f if f > 0.0 => material.alpha_cutoff().unwrap_or(0.5) / f,
+            _ => f32::MAX,
+        },
+        anisotropy_cos: rotation.cos(),
+        anisotropy_sin: rotation.sin(),
+        clearcoat_roughness: material
+            .extension_value("KHR_materials_clearcoat")
+            .and_then(|e| e.get("clearcoatRoughnessFactor"))
+            .and_then(|v| v.as_f64())
+            .unwrap_or(0.0) as f32,
+        pad: 0.0,
+        base_color_factor: factor,
+        sheen_color_factor: extension_color("KHR_materials_sheen", "sheenColorFactor", [0.0; 3]),
+        specular_color_factor: extension_color("KHR_materials_specular", "specularColorFactor", [1.0; 3]),
+        slots,
+    }
 }
 
 impl Rasterizer {
@@ -200,6 +323,7 @@ impl Rasterizer {
         asset: &Asset,
         geometry: &Geometry,
         used: &[UsedMaterial],
+        kinds: &[Vec<MapKind>],
         width: u32,
         height: u32,
     ) -> Result<Rasterizer> {
@@ -217,24 +341,31 @@ impl Rasterizer {
             attribute(4, f32x(2), 48),
             attribute(5, f32x(4), 56),
         ];
-        let pipeline = GraphicsPipeline::new(
-            ctx,
-            &PipelineDesc {
-                vertex: &shaders::BAKE_VERTEX,
-                fragment: &shaders::BAKE_FRAGMENT,
-                stride: std::mem::size_of::<Vertex>() as u32,
-                attributes: &attributes,
-                color_formats: &TARGETS,
-                depth_format: vk::Format::D32_SFLOAT,
-                textures: 3,
-                push_size: std::mem::size_of::<DrawConstants>() as u32,
-            },
-        )?;
+        let pipeline = |fragment, color_formats| {
+            GraphicsPipeline::new(
+                ctx,
+                &PipelineDesc {
+                    vertex: &shaders::BAKE_VERTEX,
+                    fragment,
+                    stride: std::mem::size_of::<Vertex>() as u32,
+                    attributes: &attributes,
+                    color_formats,
+                    depth_format: vk::Format::D32_SFLOAT,
+                    textures: SLOTS as u32,
+                    push_size: std::mem::size_of::<DrawConstants>() as u32,
+                },
+            )
+        };
+        let geometry_pipeline = pipeline(&shaders::BAKE_FRAGMENT, &GEOMETRY_TARGETS)?;
+        let with_maps = kinds.iter().any(|k| !k.is_empty());
+        let maps_pipeline = match with_maps {
+            true => Some(pipeline(&shaders::BAKE_MAPS_FRAGMENT, &MAP_TARGETS)?),
+            false => None,
+        };
         let vertices = Buffer::vertices(ctx, bytemuck::cast_slice(&geometry.vertices))?;
-        let targets = TARGETS
-            .iter()
-            .map(|&format| Image::color_target(ctx, format, width, height))
-            .collect::<Result<Vec<_>>>()?;
+        let formats = GEOMETRY_TARGETS.iter().chain(if with_maps { &MAP_TARGETS[..] } else { &[] });
+        let targets =
+            formats.map(|&format| Image::color_target(ctx, format, width, height)).collect::<Result<Vec<_>>>()?;
         let depth = Image::depth_target(ctx, width, height)?;
         // Each target's copy starts on a 16-byte boundary: copies must start on a whole texel.
         let mut offsets = Vec::new();
@@ -245,111 +376,84 @@ impl Rasterizer {
         }
         let staging = Buffer::staging(ctx, end)?;
 
-        // Textures, each image and sampler made once however many materials share it.
-        let mut textures: Vec<Image> = Vec::new();
-        let mut samplers: Vec<Sampler> = Vec::new();
-        let mut texture_of: HashMap<(usize, usize), usize> = HashMap::new();
-        let mut sampler_of: HashMap<SamplerDescKey, usize> = HashMap::new();
-        // Neutral stand-ins for missing maps: a flat normal, white.
-        textures.push(Image::texture(ctx, 1, 1, &[128, 128, 255, 255])?);
-        textures.push(Image::texture(ctx, 1, 1, &[255, 255, 255, 255])?);
-        samplers.push(Sampler::new(ctx, SamplerDesc::default())?);
+        // Textures, each image (in its colour space) and sampler made once however many
+        // materials share it, with stand-ins for empty slots: a flat normal, white.
+        let mut images: Vec<Image> = vec![
+            Image::texture(ctx, &[image::RgbaImage::from_pixel(1, 1, image::Rgba([128, 128, 255, 255]))], false)?,
+            Image::texture(ctx, &[image::RgbaImage::from_pixel(1, 1, image::Rgba([255; 4]))], false)?,
+        ];
         let (flat, white) = (0usize, 1usize);
-        let mut texture = |info: Option<gltf::Texture>, fallback: usize| -> Result<(usize, usize)> {
-            let Some(texture) = info else { return Ok((fallback, 0)) };
-            let desc = sampler_desc(&texture.sampler());
-            let sampler = match sampler_of.get(&SamplerDescKey(desc)) {
-                Some(&i) => i,
-                None => {
-                    samplers.push(Sampler::new(ctx, desc)?);
-                    sampler_of.insert(SamplerDescKey(desc), samplers.len() - 1);
-                    samplers.len() - 1
-                }
-            };
-            let key = (texture.source().index(), 0);
-            let image = match texture_of.get(&key) {
-                Some(&i) => i,
-                None => {
-                    let pixels = asset.texture_image(&texture);
-                    textures.push(Image::texture(ctx, pixels.width(), pixels.height(), pixels.as_raw()).map_err(
-                        |e| Error::input_file(&asset.path, format!("image {}: {e}", texture.source().index())),
-                    )?);
-                    texture_of.insert(key, textures.len() - 1);
-                    textures.len() - 1
-                }
-            };
-            Ok((image, sampler))
-        };
-        let mut bindings = Vec::new();
-        let mut constants = Vec::new();
-        for used_material in used {
-            let material = material_of(asset, used_material.index);
-            let pbr = material.pbr_metallic_roughness();
-            let normal = material.normal_texture();
-            let metal_rough = pbr.metallic_roughness_texture();
-            let masked = material.alpha_mode() == gltf::material::AlphaMode::Mask;
-            let base_color = pbr.base_color_texture();
-            let mut flags = 0;
-            if material.double_sided() {
-                flags |= DRAW_DOUBLE_SIDED;
-            }
-            if normal.is_some() {
-                flags |= DRAW_NORMAL_MAP;
-            }
-            if metal_rough.is_some() {
-                flags |= DRAW_METAL_ROUGH_MAP;
-            }
-            if masked {
-                flags |= DRAW_ALPHA_MASK;
-            }
-            if base_color.is_some() {
-                flags |= DRAW_BASE_COLOR_MAP;
-            }
-            let uv_sets = normal.as_ref().map_or(0, |t| t.tex_coord().min(1))
-                | metal_rough.as_ref().map_or(0, |t| t.tex_coord().min(1)) << 2
-                | base_color.as_ref().map_or(0, |t| t.tex_coord().min(1)) << 4;
-            let anisotropy = materials::anisotropy(&material).map_or(0.0, |a| a.rotation);
-            constants.push((
-                flags,
-                normal.as_ref().map_or(1.0, |t| t.scale()),
-                uv_sets,
-                // The shader compares COLOR_0's alpha times the texture's; dividing the cutoff
-                // by the factor's alpha brings that in too.
-                match pbr.base_color_factor()[3] {
-                    factor if factor > 0.0 => material.alpha_cutoff().unwrap_or(0.5) / factor,
-                    _ => f32::MAX,
-                },
-                (anisotropy.cos(), anisotropy.sin()),
-            ));
-            bindings.push([
-                texture(normal.map(|t| t.texture()), flat)?,
-                texture(metal_rough.map(|t| t.texture()), white)?,
-                texture(base_color.map(|t| t.texture()), white)?,
-            ]);
-        }
+        let mut samplers: Vec<Sampler> = vec![Sampler::new(ctx, SamplerDesc::default())?];
+        let mut image_of: HashMap<(usize, bool), usize> = HashMap::new();
+        let mut sampler_of: HashMap<SamplerDesc, usize> = HashMap::new();
         let mut gpu_materials = Vec::new();
-        for (binding, (flags, normal_scale, uv_sets, alpha_cutoff, anisotropy)) in bindings.iter().zip(constants) {
-            let set = pipeline.texture_set(&binding.map(|(image, sampler)| (&textures[image], &samplers[sampler])))?;
-            gpu_materials.push(GpuMaterial { flags, normal_scale, uv_sets, alpha_cutoff, anisotropy, set });
+        let mut bindings = Vec::new();
+        for (used_material, kinds) in used.iter().zip(kinds) {
+            let material = material_of(asset, used_material.index);
+            let references = textures::material_textures(&material);
+            gpu_materials.push(gpu_material(&material, kinds, &references));
+            let mut binding = [(white, 0usize); SLOTS];
+            binding[Slot::Normal as usize].0 = flat;
+            for (slot, reference) in Slot::ALL.into_iter().zip(references) {
+                let Some(reference) = reference else { continue };
+                let texture = asset.document.textures().nth(reference.texture).expect("checked on load");
+                let desc = sampler_desc(&texture.sampler());
+                let sampler = match sampler_of.get(&desc) {
+                    Some(&i) => i,
+                    None => {
+                        samplers.push(Sampler::new(ctx, desc)?);
+                        sampler_of.insert(desc, samplers.len() - 1);
+                        samplers.len() - 1
+                    }
+                };
+                let key = (texture.source().index(), slot.is_srgb());
+                let image = match image_of.get(&key) {
+                    Some(&i) => i,
+                    None => {
+                        let levels = textures::mip_chain(asset.texture_image(&texture), key.1);
+                        images.push(Image::texture(ctx, &levels, key.1).map_err(|e| {
+                            Error::input_file(&asset.path, format!("image {}: {e}", texture.source().index()))
+                        })?);
+                        image_of.insert(key, images.len() - 1);
+                        images.len() - 1
+                    }
+                };
+                binding[slot as usize] = (image, sampler);
+            }
+            bindings.push(binding);
+        }
+        let material_buffer = Buffer::with_data(ctx, bytemuck::cast_slice(&gpu_materials))?;
+        let mut sets = Vec::new();
+        for binding in &bindings {
+            let textures: Vec<(&Image, &Sampler)> = binding.iter().map(|&(i, s)| (&images[i], &samplers[s])).collect();
+            let maps_set = match &maps_pipeline {
+                Some(p) => Some(p.texture_set(&textures, &material_buffer)?),
+                None => None,
+            };
+            sets.push((geometry_pipeline.texture_set(&textures, &material_buffer)?, maps_set));
         }
         Ok(Rasterizer {
             ctx: ctx.clone(),
             width,
             height,
-            pipeline,
+            geometry_pipeline,
+            maps_pipeline,
             vertices,
-            materials: gpu_materials,
+            sets,
+            double_sided: gpu_materials.iter().map(|m| m.flags & MATERIAL_DOUBLE_SIDED != 0).collect(),
             slot_of: used.iter().enumerate().map(|(slot, m)| (m.index, slot)).collect(),
             targets,
             depth,
             staging,
             offsets,
-            _textures: textures,
+            _materials: material_buffer,
+            _textures: images,
             _samplers: samplers,
         })
     }
 
-    /// Draws the scene once, with the camera nudged by `offset` pixels, and reads it back.
+    /// Draws the scene once (twice with maps), with the camera nudged by `offset` pixels, and
+    /// reads it back.
     fn pass(&self, geometry: &Geometry, camera: &Camera, offset: (f32, f32)) -> Result<Samples<'_>> {
         let (width, height) = (self.width, self.height);
         // Moving clip space by −offset puts the pixel's sample at +offset from its centre.
@@ -357,65 +461,68 @@ impl Rasterizer {
             Mat4::from_translation(Vec3::new(-2.0 * offset.0 / width as f32, -2.0 * offset.1 / height as f32, 0.0));
         let view_projection = nudge * camera.view_projection;
         let device = &self.ctx.device;
+        let toward_eye = -camera.forward;
+        let (geometry_targets, map_targets) = self.targets.split_at(GEOMETRY_TARGETS.len());
         self.ctx.run(|cmd| {
-            let clear = vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } };
-            let colors: Vec<_> = self
-                .targets
-                .iter()
-                .map(|target| {
-                    vk::RenderingAttachmentInfo::default()
-                        .image_view(target.view)
-                        .image_layout(vk::ImageLayout::GENERAL)
-                        .load_op(vk::AttachmentLoadOp::CLEAR)
-                        .store_op(vk::AttachmentStoreOp::STORE)
-                        .clear_value(clear)
-                })
-                .collect();
-            let depth = vk::RenderingAttachmentInfo::default()
-                .image_view(self.depth.view)
-                .image_layout(vk::ImageLayout::GENERAL)
-                .load_op(vk::AttachmentLoadOp::CLEAR)
-                .store_op(vk::AttachmentStoreOp::DONT_CARE)
-                .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
-            let info = vk::RenderingInfo::default()
-                .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width, height } })
-                .layer_count(1)
-                .color_attachments(&colors)
-                .depth_attachment(&depth);
-            unsafe {
-                device.cmd_begin_rendering(cmd, &info);
-                device.cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.buffer], &[0]);
+            let draw_all = |cmd, pipeline: &GraphicsPipeline, targets: &[Image], maps: bool| {
+                let clear = vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } };
+                let colors: Vec<_> = targets
+                    .iter()
+                    .map(|target| {
+                        vk::RenderingAttachmentInfo::default()
+                            .image_view(target.view)
+                            .image_layout(vk::ImageLayout::GENERAL)
+                            .load_op(vk::AttachmentLoadOp::CLEAR)
+                            .store_op(vk::AttachmentStoreOp::STORE)
+                            .clear_value(clear)
+                    })
+                    .collect();
+                let depth = vk::RenderingAttachmentInfo::default()
+                    .image_view(self.depth.view)
+                    .image_layout(vk::ImageLayout::GENERAL)
+                    .load_op(vk::AttachmentLoadOp::CLEAR)
+                    .store_op(vk::AttachmentStoreOp::DONT_CARE)
+                    .clear_value(vk::ClearValue {
+                        depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 },
+                    });
+                let info = vk::RenderingInfo::default()
+                    .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width, height } })
+                    .layer_count(1)
+                    .color_attachments(&colors)
+                    .depth_attachment(&depth);
+                unsafe {
+                    device.cmd_begin_rendering(cmd, &info);
+                    device.cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.buffer], &[0]);
+                }
+                pipeline.record_bind(cmd, width, height);
+                for draw in &geometry.draws {
+                    let slot = self.slot_of[&draw.material];
+                    let constants = DrawConstants {
+                        view_projection: view_projection.to_cols_array(),
+                        eye: [camera.eye.x, camera.eye.y, camera.eye.z, if camera.orthographic { 0.0 } else { 1.0 }],
+                        toward_eye: [toward_eye.x, toward_eye.y, toward_eye.z, 0.0],
+                        object_id: draw.object_id,
+                        material: slot as u32,
+                    };
+                    let (geometry_set, maps_set) = &self.sets[slot];
+                    let set =
+                        if maps { maps_set.as_ref().expect("a maps set with the maps pass") } else { geometry_set };
+                    pipeline.record_draw(
+                        cmd,
+                        set,
+                        bytemuck::bytes_of(&constants),
+                        self.double_sided[slot],
+                        draw.first_vertex,
+                        draw.vertex_count,
+                    );
+                }
+                unsafe { device.cmd_end_rendering(cmd) };
+                crate::gpu::context::full_barrier(device, cmd);
+            };
+            draw_all(cmd, &self.geometry_pipeline, geometry_targets, false);
+            if let Some(maps) = &self.maps_pipeline {
+                draw_all(cmd, maps, map_targets, true);
             }
-            self.pipeline.record_bind(cmd, width, height);
-            let toward_eye = -camera.forward;
-            for draw in &geometry.draws {
-                let used_index = self.slot_of[&draw.material];
-                let material = &self.materials[used_index];
-                let constants = DrawConstants {
-                    view_projection: view_projection.to_cols_array(),
-                    eye: [camera.eye.x, camera.eye.y, camera.eye.z, if camera.orthographic { 0.0 } else { 1.0 }],
-                    toward_eye: [toward_eye.x, toward_eye.y, toward_eye.z, 0.0],
-                    object_id: draw.object_id,
-                    material: used_index as u32 + 1,
-                    flags: material.flags,
-                    normal_scale: material.normal_scale,
-                    uv_sets: material.uv_sets,
-                    alpha_cutoff: material.alpha_cutoff,
-                    anisotropy_cos: material.anisotropy.0,
-                    anisotropy_sin: material.anisotropy.1,
-                };
-                let both_sides = material.flags & DRAW_DOUBLE_SIDED != 0;
-                self.pipeline.record_draw(
-                    cmd,
-                    &material.set,
-                    bytemuck::bytes_of(&constants),
-                    both_sides,
-                    draw.first_vertex,
-                    draw.vertex_count,
-                );
-            }
-            unsafe { device.cmd_end_rendering(cmd) };
-            crate::gpu::context::full_barrier(device, cmd);
             for (target, &offset) in self.targets.iter().zip(&self.offsets) {
                 target.record_read_at(cmd, &self.staging, offset);
             }
@@ -434,42 +541,9 @@ impl Rasterizer {
             view: bytemuck::cast_slice(next(16)),
             ids: bytemuck::cast_slice(next(8)),
             color: bytemuck::cast_slice(next(16)),
-            metal_rough: bytemuck::cast_slice(next(8)),
-            base_color: bytemuck::cast_slice(next(16)),
+            maps: (GEOMETRY_TARGETS.len()..self.targets.len()).map(|_| bytemuck::cast_slice(next(16))).collect(),
         })
     }
-}
-
-/// A hashable form of [`SamplerDesc`].
-#[derive(Clone, Copy, PartialEq, Eq)]
-struct SamplerDescKey(SamplerDesc);
-
-impl std::hash::Hash for SamplerDescKey {
-    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
-        let d = self.0;
-        [d.magnify.as_raw(), d.minify.as_raw(), d.wrap_u.as_raw(), d.wrap_v.as_raw()].hash(state);
-    }
-}
-
-fn sampler_desc(sampler: &gltf::texture::Sampler) -> SamplerDesc {
-    use gltf::texture::{MagFilter, MinFilter, WrappingMode};
-    let wrap = |mode: WrappingMode| match mode {
-        WrappingMode::ClampToEdge => vk::SamplerAddressMode::CLAMP_TO_EDGE,
-        WrappingMode::MirroredRepeat => vk::SamplerAddressMode::MIRRORED_REPEAT,
-        WrappingMode::Repeat => vk::SamplerAddressMode::REPEAT,
-    };
-    let magnify = match sampler.mag_filter() {
-        Some(MagFilter::Nearest) => vk::Filter::NEAREST,
-        _ => vk::Filter::LINEAR,
-    };
-    // Without mip maps, the mip filter is dropped and the base filter kept.
-    let minify = match sampler.min_filter() {
-        Some(MinFilter::Nearest | MinFilter::NearestMipmapNearest | MinFilter::NearestMipmapLinear) => {
-            vk::Filter::NEAREST
-        }
-        _ => vk::Filter::LINEAR,
-    };
-    SamplerDesc { magnify, minify, wrap_u: wrap(sampler.wrap_s()), wrap_v: wrap(sampler.wrap_t()) }
 }
 
 /// Per-pixel sums over the passes.
@@ -489,83 +563,18 @@ struct Accumulator {
     material_hits: Vec<Vec<u16>>,
     /// COLOR_0 sums, when any primitive has vertex colours.
     color: Option<Vec<Vec4>>,
-    /// Per used material with a metallic-roughness texture or texture axes: its texture sums.
-    textures: Vec<Option<TextureSums>>,
-}
-
-/// Per-pixel sums, over a material's samples, of its texture values and corner-layer weights
-/// (README: Texture layers).
-struct TextureSums {
-    /// Whether the material has a metallic-roughness texture, whose raw values are always masks.
-    metal_rough: bool,
-    axes: Vec<Axis>,
-    /// The base colour factor, which multiplies the texture's texels.
-    color_factor: [f32; 3],
-    /// Per pixel: metallic, roughness, then one position per axis, then the weight of each
-    /// corner layer but the first.
-    sums: Vec<f32>,
-    stride: usize,
-}
-
-impl TextureSums {
-    fn new(material: &gltf::Material, axes: Vec<Axis>, pixels: usize) -> TextureSums {
-        let stride = 2 + axes.len() + (1 << axes.len()) - 1;
-        let factor = material.pbr_metallic_roughness().base_color_factor();
-        TextureSums {
-            metal_rough: material.pbr_metallic_roughness().metallic_roughness_texture().is_some(),
-            axes,
-            color_factor: [factor[0], factor[1], factor[2]],
-            sums: vec![0.0; pixels * stride],
-            stride,
-        }
-    }
-
-    fn add(&mut self, pixel: usize, metal_rough: [f32; 2], color: [f32; 4]) {
-        let color = [0, 1, 2].map(|k| color[k] * self.color_factor[k]);
-        let positions: Vec<f32> = self.axes.iter().map(|axis| axis.position(metal_rough, color)).collect();
-        let sums = &mut self.sums[pixel * self.stride..(pixel + 1) * self.stride];
-        let values = metal_rough.iter().chain(&positions).copied().chain(materials::corner_weights(&positions));
-        for (sum, value) in sums.iter_mut().zip(values) {
-            *sum += value;
-        }
-    }
-
-    /// The masks, each sum over the pixel's hits on any material: so that where materials meet,
-    /// each one's texture layers take only its share.
-    fn masks(&self, channel: &str, hits: &[u16], masks: &mut BTreeMap<String, Vec<f32>>) {
-        let mean = |k: usize| -> Vec<f32> {
-            hits.iter()
-                .enumerate()
-                .map(|(p, &h)| if h > 0 { self.sums[p * self.stride + k] / h as f32 } else { 0.0 })
-                .collect()
-        };
-        if self.metal_rough {
-            masks.insert(format!("{channel}.metallic"), mean(0));
-            masks.insert(format!("{channel}.roughness"), mean(1));
-        }
-        for (i, axis) in self.axes.iter().enumerate() {
-            if matches!(axis, Axis::BaseColor { .. }) {
-                masks.insert(materials::value_mask(channel, axis), mean(2 + i));
-            }
-        }
-        for corner in 1..1usize << self.axes.len() {
-            masks.insert(materials::corner_mask(channel, &self.axes, corner), mean(2 + self.axes.len() + corner - 1));
-        }
-    }
+    /// Per used material: the bits of its map kinds.
+    material_kinds: Vec<u32>,
+    /// Per map kind any material has: samples of materials with it.
+    kind_hits: Vec<(MapKind, Vec<u16>)>,
+    /// Per map channel of those kinds ([`MAP_CHANNELS`] index): the sum of its values.
+    map_sums: Vec<(usize, Vec<f32>)>,
 }
 
 impl Accumulator {
-    fn new(width: u32, height: u32, used: &[UsedMaterial], asset: &Asset, geometry: &Geometry) -> Accumulator {
+    fn new(width: u32, height: u32, kinds: &[Vec<MapKind>], geometry: &Geometry) -> Accumulator {
         let pixels = (width * height) as usize;
-        let textures = used
-            .iter()
-            .map(|m| {
-                let material = material_of(asset, m.index);
-                let axes = materials::map(asset, &material).axes;
-                let textured = material.pbr_metallic_roughness().metallic_roughness_texture().is_some();
-                (textured || !axes.is_empty()).then(|| TextureSums::new(&material, axes, pixels))
-            })
-            .collect();
+        let present: Vec<MapKind> = MapKind::ALL.into_iter().filter(|k| kinds.iter().any(|m| m.contains(k))).collect();
         Accumulator {
             width,
             height,
@@ -576,9 +585,14 @@ impl Accumulator {
             handedness: vec![0; pixels],
             view: vec![Vec3::ZERO; pixels],
             vote: vec![(0, 0); pixels],
-            material_hits: used.iter().map(|_| vec![0; pixels]).collect(),
+            material_hits: kinds.iter().map(|_| vec![0; pixels]).collect(),
             color: geometry.draws.iter().any(|d| d.has_colors).then(|| vec![Vec4::ZERO; pixels]),
-            textures,
+            material_kinds: kinds.iter().map(|k| k.iter().map(|k| k.bit()).sum()).collect(),
+            kind_hits: present.iter().map(|&k| (k, vec![0; pixels])).collect(),
+            map_sums: (0..MAP_CHANNELS.len())
+                .filter(|&c| present.contains(&MAP_CHANNELS[c].kind))
+                .map(|c| (c, vec![0.0; pixels]))
+                .collect(),
         }
     }
 
@@ -607,8 +621,22 @@ impl Accumulator {
             if let Some(color) = &mut self.color {
                 color[p] += Vec4::from(s.color[p]);
             }
-            if let Some(sums) = &mut self.textures[slot] {
-                sums.add(p, s.metal_rough[p], s.base_color[p]);
+        }
+        // The maps pass's samples, each counted for the material it names (its alpha).
+        let Some(named) = s.maps.first() else { return };
+        for p in 0..self.hits.len() {
+            let material = named[p][3] as usize;
+            let Some(&kinds) = material.checked_sub(1).and_then(|slot| self.material_kinds.get(slot)) else {
+                continue;
+            };
+            for (kind, hits) in &mut self.kind_hits {
+                hits[p] += u16::from(kinds & kind.bit() != 0);
+            }
+            for (channel, sums) in &mut self.map_sums {
+                let c = &MAP_CHANNELS[*channel];
+                if kinds & c.kind.bit() != 0 {
+                    sums[p] += s.maps[c.target][p][c.component];
+                }
             }
         }
     }
@@ -643,9 +671,15 @@ impl Accumulator {
         let mut masks = BTreeMap::new();
         for (slot, material) in used.iter().enumerate() {
             masks.insert(material.channel.clone(), share(&self.material_hits[slot]));
-            if let Some(sums) = &self.textures[slot] {
-                sums.masks(&material.channel, &self.hits, &mut masks);
-            }
+        }
+        // Each map is the mean over the samples of the materials that write it: where a textured
+        // material meets another, the map holds the textured one's value for its layer.
+        let mut maps = BTreeMap::new();
+        for (channel, sums) in &self.map_sums {
+            let c = &MAP_CHANNELS[*channel];
+            let (_, hits) = self.kind_hits.iter().find(|(k, _)| *k == c.kind).expect("a count per kind present");
+            let values = sums.iter().zip(hits).map(|(&sum, &h)| if h > 0 { sum / h as f32 } else { 0.0 }).collect();
+            maps.insert(c.name.to_string(), values);
         }
         if let Some(color) = &self.color {
             for (k, channel) in ["r", "g", "b", "a"].iter().enumerate() {
@@ -664,7 +698,7 @@ impl Accumulator {
             coverage,
             object_id,
             masks,
-            maps: BTreeMap::new(),
+            maps,
             object_names,
             has_view: true,
             has_tangent: true,

@@ -1,18 +1,20 @@
 //! Importing an asset's materials: one preset per material, and a look that layers them
-//! through the bake's masks (README: lookdev import).
+//! through the bake's masks and binds their maps (README: lookdev import).
 //!
 //! The look has one stack, the default one, since every object of a baked asset tells its
 //! materials apart by mask rather than by id. The first material fills; each other material is a
-//! layer through its own mask, at the start of each of its texture [`Axis`]; a material with
-//! textured axes adds a corner layer for every other corner of their box right above its own.
+//! layer through its own mask. Each layer binds the parameters its material's textures drive to
+//! the bake's maps ([`MapKind`]), so that the value at a pixel is the preset's factor times the
+//! map's.
 
 use super::geometry::primitives;
-use super::materials::{self, Axis, Mapped, UsedMaterial};
+use super::materials::{self, MapKind, Mapped, UsedMaterial};
 use super::Asset;
 use crate::material::look::{EnvironmentSettings, Layer, Look, ObjectStack, RenderSettings};
 use crate::material::params::Param;
 use crate::material::Preset;
 use crate::{Error, Result};
+use std::collections::BTreeMap;
 use std::path::{Component, Path, PathBuf};
 
 /// One imported material: its names, its preset and what the mapping could not carry.
@@ -29,17 +31,24 @@ pub struct Import {
     pub unsupported: Vec<String>,
 }
 
+/// The bindings of a layer whose material has these map kinds.
+pub fn map_bindings(kinds: &[MapKind]) -> BTreeMap<Param, String> {
+    kinds.iter().flat_map(|k| k.bindings()).map(|&(param, map)| (param, map.to_string())).collect()
+}
+
 impl Import {
     /// Maps every material the scene's primitives use.
     pub fn new(asset: &Asset) -> Result<Import> {
         let primitives = primitives(asset)?;
         let used = materials::used(asset, primitives.iter().map(|(_, p)| p.material().index()));
+        let colored = materials::with_vertex_colors(asset);
         let source =
             asset.path.file_name().map_or_else(|| asset.path.display().to_string(), |n| n.to_string_lossy().into());
         let materials = used
             .into_iter()
             .map(|used| {
-                let mapped = materials::map(asset, &materials::material_of(asset, used.index));
+                let material = materials::material_of(asset, used.index);
+                let mapped = materials::map(&material, colored.contains(&used.index));
                 let mut description = format!("'{}' from {source}.", used.label);
                 for note in &mapped.notes {
                     description.push_str(&format!(" {}{}.", note[..1].to_uppercase(), &note[1..]));
@@ -60,31 +69,18 @@ impl Import {
 
     /// The look, its layers naming each preset by `preset_reference(name)`.
     pub fn look(&self, look_file: &Path, preset_reference: impl Fn(&str) -> String) -> Look {
-        let mut layers = Vec::new();
-        for (rank, imported) in self.materials.iter().enumerate() {
-            let reference = preset_reference(&imported.preset.name);
-            let params = imported.mapped.params;
-            let channel = &imported.used.channel;
-            let axes = &imported.mapped.axes;
-            // The corner of the axes' box where the axes in `corner` are at their end.
-            let layer = |mask: Option<String>, corner: usize| {
-                let mut layer = Layer { preset: Some(reference.clone()), mask, ..Layer::filling(params) };
-                for (i, axis) in axes.iter().enumerate() {
-                    axis.apply(&mut layer.params, corner & (1 << i) != 0);
-                    layer.overrides.push(match axis {
-                        Axis::Metallic { .. } => Param::Metallic,
-                        Axis::Roughness { .. } => Param::Roughness,
-                        Axis::BaseColor { .. } => Param::BaseColor,
-                    });
-                }
-                layer.overrides.sort();
-                layer
-            };
-            layers.push(layer((rank > 0).then(|| channel.clone()), 0));
-            for corner in 1..1usize << axes.len() {
-                layers.push(layer(Some(materials::corner_mask(channel, axes, corner)), corner));
-            }
-        }
+        let layers = self
+            .materials
+            .iter()
+            .enumerate()
+            .map(|(rank, imported)| Layer {
+                preset: Some(preset_reference(&imported.preset.name)),
+                // The first material fills; the others show through their masks.
+                mask: (rank > 0).then(|| imported.used.channel.clone()),
+                maps: map_bindings(&imported.mapped.maps),
+                ..Layer::filling(imported.mapped.params)
+            })
+            .collect();
         Look {
             file: Some(look_file.to_path_buf()),
             environment: EnvironmentSettings::default(),
@@ -122,7 +118,7 @@ impl Import {
         });
         let header = format!(
             "# The materials of {}, imported by lookdev import. Bake the g-buffer with\n\
-             # lookdev bake on the same file: the masks below are the bake's.\n",
+             # lookdev bake on the same file: the masks and maps below are the bake's.\n",
             asset.path.file_name().map_or_else(|| asset.path.display().to_string(), |n| n.to_string_lossy().into())
         );
         let text = format!("{header}{}\n", look.to_toml());
@@ -154,22 +150,11 @@ fn relative_path(from: &Path, to: &Path) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gbuffer::GBuffer;
+    use crate::material::stack::PackedStacks;
     use crate::material::Params;
 
-    /// What the look's stack blends to at a pixel with these mask values, as `resolve.comp` does.
-    fn blend(look: &Look, mask_value: impl Fn(&str) -> f32) -> Params {
-        let stack = &look.objects[0];
-        let weights = crate::material::stack::layer_weights(stack, mask_value);
-        let mut params = stack.layers[0].params;
-        for (layer, weight) in stack.layers.iter().zip(weights).skip(1) {
-            if let Some(weight) = weight {
-                params = params.mix(&layer.params, weight.blend);
-            }
-        }
-        params
-    }
-
-    fn imported(channel: &str, base_color: [f32; 3], axes: Vec<Axis>) -> ImportedMaterial {
+    fn imported(channel: &str, base_color: [f32; 3], maps: Vec<MapKind>) -> ImportedMaterial {
         let params = Params { base_color, metallic: 0.4, roughness: 0.3, ..Params::default() };
         ImportedMaterial {
             used: UsedMaterial {
@@ -178,7 +163,7 @@ mod tests {
                 channel: channel.into(),
                 preset: channel.into(),
             },
-            mapped: Mapped { params, axes, notes: Vec::new(), unsupported: Vec::new() },
+            mapped: Mapped { params, maps, notes: Vec::new(), unsupported: Vec::new() },
             preset: Preset {
                 name: channel.into(),
                 description: String::new(),
@@ -190,81 +175,78 @@ mod tests {
         }
     }
 
-    /// The bake's corner masks at a pixel wholly on a material whose texels sit at `x` along
-    /// its axes.
-    fn texture_masks(channel: &'static str, axes: Vec<Axis>, x: Vec<f32>) -> impl Fn(&str) -> f32 {
-        let weights = materials::corner_weights(&x);
-        move |name: &str| {
-            if name == channel {
-                return 1.0;
-            }
-            (1..weights.len() + 1)
-                .find(|&corner| materials::corner_mask(channel, &axes, corner) == name)
-                .map(|corner| weights[corner - 1])
-                .unwrap_or(0.0)
-        }
+    /// A one-pixel g-buffer of object 1 with these masks and the bake's maps.
+    fn pixel(masks: &[(&str, f32)], maps: &[(&str, f32)]) -> GBuffer {
+        let mut g = GBuffer::shaderball(1, 1);
+        g.object_id = vec![1];
+        g.coverage = vec![1.0];
+        g.masks = masks.iter().map(|&(n, v)| (n.to_string(), vec![v])).collect();
+        g.maps = maps.iter().map(|&(n, v)| (n.to_string(), vec![v])).collect();
+        g
     }
 
     #[test]
-    fn corner_layers_reproduce_every_texel() {
-        let colour = Axis::BaseColor { from: [0.1, 0.2, 0.3], to: [0.7, 0.5, 0.4] };
-        let sets: Vec<Vec<Axis>> = vec![
-            vec![Axis::Metallic { factor: 0.9 }],
-            vec![Axis::Roughness { factor: 0.8 }],
-            vec![colour],
-            vec![Axis::Metallic { factor: 0.9 }, Axis::Roughness { factor: 0.8 }],
-            vec![Axis::Metallic { factor: 1.0 }, Axis::Roughness { factor: 0.5 }, colour],
-        ];
-        for axes in sets {
-            let import =
-                Import { materials: vec![imported("paint", [0.8, 0.1, 0.1], axes.clone())], unsupported: Vec::new() };
-            let look = import.look(Path::new("look.toml"), str::to_string);
-            assert_eq!(look.objects[0].layers.len(), 1 << axes.len());
-            for x in [0.0f32, 1.0, 0.25, 0.9, 0.5] {
-                // Each axis at a different place: x, 1 − x, then x².
-                let at: Vec<f32> = [x, 1.0 - x, x * x][..axes.len()].to_vec();
-                let p = blend(&look, texture_masks("paint", axes.clone(), at.clone()));
-                let mut want =
-                    Params { base_color: [0.8, 0.1, 0.1], metallic: 0.4, roughness: 0.3, ..Params::default() };
-                for (axis, &t) in axes.iter().zip(&at) {
-                    match *axis {
-                        Axis::Metallic { factor } => want.metallic = factor * t,
-                        Axis::Roughness { factor } => want.roughness = factor * t,
-                        Axis::BaseColor { from, to } => {
-                            want.base_color = [0, 1, 2].map(|k| from[k] + t * (to[k] - from[k]))
-                        }
-                    }
-                }
-                let error = (0..3)
-                    .map(|k| (p.base_color[k] - want.base_color[k]).abs())
-                    .chain([(p.metallic - want.metallic).abs(), (p.roughness - want.roughness).abs()])
-                    .fold(0.0, f32::max);
-                assert!(error < 1e-5, "{axes:?} at {at:?}: {p:?}");
-            }
-        }
-    }
-
-    #[test]
-    fn each_material_shows_through_its_own_mask() {
-        let axes = vec![Axis::Metallic { factor: 1.0 }, Axis::Roughness { factor: 1.0 }];
+    fn each_material_shows_through_its_own_mask_with_its_factors_times_its_maps() {
         let import = Import {
             materials: vec![
                 imported("paint", [0.8, 0.1, 0.1], Vec::new()),
-                imported("metal", [0.9, 0.9, 0.9], axes.clone()),
+                imported("metal", [0.9, 0.9, 0.9], vec![MapKind::BaseColor, MapKind::MetallicRoughness]),
             ],
             unsupported: Vec::new(),
         };
         let look = import.look(Path::new("look.toml"), str::to_string);
         let layers = &look.objects[0].layers;
         assert_eq!(layers[0].mask, None, "the first material fills");
+        assert!(layers[0].maps.is_empty(), "an untextured material binds nothing");
         assert_eq!(layers[1].mask.as_deref(), Some("metal"));
-        // On the paint: the metal's mask and its corner masks are 0 there.
-        let paint = blend(&look, |name| if name.starts_with("metal") { 0.0 } else { 1.0 });
+        let bound: Vec<(Param, &str)> = layers[1].maps.iter().map(|(p, m)| (*p, m.as_str())).collect();
+        assert_eq!(
+            bound,
+            [(Param::BaseColor, "base_color"), (Param::Metallic, "metallic"), (Param::Roughness, "roughness")]
+        );
+
+        let maps = [
+            ("base_color.R", 0.5),
+            ("base_color.G", 0.25),
+            ("base_color.B", 1.0),
+            ("metallic", 1.0),
+            ("roughness", 0.5),
+        ];
+        let resolve =
+            |g: &GBuffer| PackedStacks::pack(&look, [1], g, Path::new("g.exr")).unwrap().resolve_gbuffer_pixel(g, 0);
+        let paint = resolve(&pixel(&[("paint", 1.0), ("metal", 0.0)], &maps));
         assert_eq!(paint.base_color, [0.8, 0.1, 0.1]);
         assert_eq!((paint.metallic, paint.roughness), (0.4, 0.3));
-        let metal = blend(&look, texture_masks("metal", axes, vec![1.0, 0.5]));
-        assert!(metal.base_color.iter().all(|&c| (c - 0.9).abs() < 1e-6), "{metal:?}");
-        assert!((metal.metallic - 1.0).abs() < 1e-6 && (metal.roughness - 0.5).abs() < 1e-6, "{metal:?}");
+        let metal = resolve(&pixel(&[("paint", 0.0), ("metal", 1.0)], &maps));
+        let want = [0.9 * 0.5, 0.9 * 0.25, 0.9];
+        assert!(metal.base_color.iter().zip(want).all(|(c, w)| (c - w).abs() < 1e-6), "{metal:?}");
+        assert!((metal.metallic - 0.4).abs() < 1e-6 && (metal.roughness - 0.15).abs() < 1e-6, "{metal:?}");
+    }
+
+    #[test]
+    fn every_map_kind_binds_the_parameters_it_drives() {
+        let all = map_bindings(&MapKind::ALL);
+        let params: Vec<Param> = all.keys().copied().collect();
+        assert_eq!(
+            params,
+            [
+                Param::BaseColor,
+                Param::Metallic,
+                Param::Specular,
+                Param::Roughness,
+                Param::Sheen,
+                Param::SheenTint,
+                Param::Clearcoat,
+                Param::ClearcoatGloss,
+                Param::Emission,
+            ]
+        );
+        // Every map a binding names is one the bake writes.
+        for map in all.values() {
+            let written =
+                materials::MAP_CHANNELS.iter().any(|c| c.name == map || c.name.starts_with(&format!("{map}.")));
+            assert!(written, "{map} is bound but never written");
+        }
     }
 
     #[test]

@@ -1,23 +1,21 @@
 //! glTF materials as Disney 2012 parameters (README: lookdev import, where each formula is
 //! given), and what the bake needs to know of them.
 //!
-//! A preset holds constants, so a material's textures become a constant (the texture's mean)
-//! and, where they vary, mask-driven layers: each textured parameter is an [`Axis`], the bake
-//! writes each texel's position along the axes and the weights of the corner layers as masks,
-//! and the look blends layers whose only difference is the textured parameters. Metallic and
-//! roughness are reproduced exactly; a base colour texture along its main colour axis.
+//! A preset holds the material's factors. Its textures become g-buffer maps ([`MapKind`]): the
+//! bake samples each texture into the map of the parameter it drives, and the imported look
+//! binds the parameter to it, so that the value at a pixel is glTF's factor × texture. Where a
+//! Disney parameter is not linear in the texture, the map holds the parameter's own value (or
+//! its ratio to the factor's), as [`MapKind`] says.
 
 use super::names::{channel_name, unique};
 use super::Asset;
-use crate::material::Params;
+use crate::material::{Param, Params};
 use gltf::json::Value;
 
 /// Largest values the look format allows (README: Presets).
 const SPECULAR_LIMIT: f32 = crate::material::params::SPECULAR_MAX;
 const SHEEN_LIMIT: f32 = crate::material::params::SHEEN_MAX;
 const CLEARCOAT_LIMIT: f32 = crate::material::params::CLEARCOAT_MAX;
-/// A texture channel that varies less than this (two 8-bit steps) is a constant.
-const VARIATION: f32 = 2.0 / 255.0;
 
 /// A material the scene's primitives use, and the names derived from it.
 #[derive(Clone, Debug, PartialEq)]
@@ -26,7 +24,7 @@ pub struct UsedMaterial {
     pub index: Option<usize>,
     /// The material's own name, or "material N" / "default material".
     pub label: String,
-    /// Its mask channel, `mask.<channel>`, and the prefix of its texture masks.
+    /// Its mask channel, `mask.<channel>`.
     pub channel: String,
     /// Its preset's name.
     pub preset: String,
@@ -73,91 +71,127 @@ pub fn material_of(asset: &Asset, index: Option<usize>) -> gltf::Material<'_> {
     }
 }
 
-/// A texture-driven parameter the look carries through masks (README: Texture layers).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Axis {
-    /// metallic = factor × the texture's blue channel.
-    Metallic { factor: f32 },
-    /// roughness = factor × the texture's green channel.
-    Roughness { factor: f32 },
-    /// base_color = mix(from, to, t), with t the texel's position along the line from `from` to
-    /// `to`: the texture's main colour axis (its first principal component).
-    BaseColor { from: [f32; 3], to: [f32; 3] },
+/// A group of maps the bake writes for a material with the textures that drive them, and the
+/// parameters the imported look binds to them. Each map channel is in \[0, 1\]:
+///
+/// | kind | maps | value at a sample |
+/// |---|---|---|
+/// | base colour | `base_color.R/G/B` | the base colour texel (linear) × `COLOR_0` |
+/// | metallic-roughness | `metallic`, `roughness` | the texel's B and G |
+/// | emission | `emission.R/G/B` | the emissive texel (linear) |
+/// | clearcoat | `clearcoat` | the clearcoat texel's R |
+/// | clearcoat gloss | `clearcoat_gloss` | gloss of `clearcoatRoughnessFactor` × the texel's G, itself (the preset's factor is 1) |
+/// | sheen | `sheen`, `sheen_tint` | the sheen colour's luminance over the factor's; the fitted tint itself (the preset's is 1) |
+/// | specular | `specular` | `specularTexture`'s A × the luminance of the specular colour over the factor's |
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum MapKind {
+    BaseColor,
+    MetallicRoughness,
+    Emission,
+    Clearcoat,
+    ClearcoatGloss,
+    Sheen,
+    Specular,
 }
 
-impl Axis {
-    /// The word in mask names.
-    pub fn name(&self) -> &'static str {
+/// One map channel the bake writes: its name (without `map.`), its kind, and where the maps
+/// pass's fragment shader puts it (target, component).
+pub struct MapChannel {
+    pub name: &'static str,
+    pub kind: MapKind,
+    pub target: usize,
+    pub component: usize,
+}
+
+const fn channel(name: &'static str, kind: MapKind, target: usize, component: usize) -> MapChannel {
+    MapChannel { name, kind, target, component }
+}
+
+/// Every map channel, in the layout of `glsl/bake_maps.frag`'s four targets.
+pub const MAP_CHANNELS: [MapChannel; 13] = [
+    channel("base_color.R", MapKind::BaseColor, 0, 0),
+    channel("base_color.G", MapKind::BaseColor, 0, 1),
+    channel("base_color.B", MapKind::BaseColor, 0, 2),
+    channel("emission.R", MapKind::Emission, 1, 0),
+    channel("emission.G", MapKind::Emission, 1, 1),
+    channel("emission.B", MapKind::Emission, 1, 2),
+    channel("metallic", MapKind::MetallicRoughness, 2, 0),
+    channel("roughness", MapKind::MetallicRoughness, 2, 1),
+    channel("clearcoat", MapKind::Clearcoat, 2, 2),
+    channel("clearcoat_gloss", MapKind::ClearcoatGloss, 2, 3),
+    channel("sheen", MapKind::Sheen, 3, 0),
+    channel("sheen_tint", MapKind::Sheen, 3, 1),
+    channel("specular", MapKind::Specular, 3, 2),
+];
+
+impl MapKind {
+    pub const ALL: [MapKind; 7] = [
+        MapKind::BaseColor,
+        MapKind::MetallicRoughness,
+        MapKind::Emission,
+        MapKind::Clearcoat,
+        MapKind::ClearcoatGloss,
+        MapKind::Sheen,
+        MapKind::Specular,
+    ];
+
+    /// The bit of this kind in the bake's per-material mask (`glsl/include/bake_material.glsl`).
+    pub fn bit(self) -> u32 {
+        1 << self as u32
+    }
+
+    /// The parameters a look binds for this kind, each with the map's name.
+    pub fn bindings(self) -> &'static [(Param, &'static str)] {
         match self {
-            Axis::Metallic { .. } => "metallic",
-            Axis::Roughness { .. } => "roughness",
-            Axis::BaseColor { .. } => "base_color",
-        }
-    }
-
-    /// Sets the parameter to its value at the axis's start (`end` false) or end.
-    pub fn apply(&self, params: &mut Params, end: bool) {
-        match *self {
-            Axis::Metallic { factor } => params.metallic = if end { factor } else { 0.0 },
-            Axis::Roughness { factor } => params.roughness = if end { factor } else { 0.0 },
-            Axis::BaseColor { from, to } => params.base_color = if end { to } else { from },
-        }
-    }
-
-    /// Where a texel's value lies along the axis, in [0, 1]. `metal_rough` is the
-    /// metallic-roughness texel's (blue, green), `color` the base colour texel, linear and
-    /// multiplied by the factor.
-    pub fn position(&self, metal_rough: [f32; 2], color: [f32; 3]) -> f32 {
-        match *self {
-            Axis::Metallic { .. } => metal_rough[0],
-            Axis::Roughness { .. } => metal_rough[1],
-            Axis::BaseColor { from, to } => {
-                let direction = [0, 1, 2].map(|k| to[k] - from[k]);
-                let length2: f32 = direction.iter().map(|d| d * d).sum();
-                let along: f32 = (0..3).map(|k| (color[k] - from[k]) * direction[k]).sum();
-                if length2 > 0.0 {
-                    (along / length2).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                }
-            }
+            MapKind::BaseColor => &[(Param::BaseColor, "base_color")],
+            MapKind::MetallicRoughness => &[(Param::Metallic, "metallic"), (Param::Roughness, "roughness")],
+            MapKind::Emission => &[(Param::Emission, "emission")],
+            MapKind::Clearcoat => &[(Param::Clearcoat, "clearcoat")],
+            MapKind::ClearcoatGloss => &[(Param::ClearcoatGloss, "clearcoat_gloss")],
+            MapKind::Sheen => &[(Param::Sheen, "sheen"), (Param::SheenTint, "sheen_tint")],
+            MapKind::Specular => &[(Param::Specular, "specular")],
         }
     }
 }
 
-/// The mask holding a texture's raw value along one axis: `<channel>.<axis>`.
-pub fn value_mask(channel: &str, axis: &Axis) -> String {
-    format!("{channel}.{}", axis.name())
+/// The materials (by glTF index, `None` for the default material) used by a primitive with
+/// `COLOR_0`: their base colour varies per vertex, so it is a map.
+pub fn with_vertex_colors(asset: &Asset) -> Vec<Option<usize>> {
+    let mut materials: Vec<Option<usize>> = asset
+        .document
+        .meshes()
+        .flat_map(|m| m.primitives())
+        .filter(|p| p.get(&gltf::Semantic::Colors(0)).is_some())
+        .map(|p| p.material().index())
+        .collect();
+    materials.sort_unstable();
+    materials.dedup();
+    materials
 }
 
-/// The mask of the corner layer `corner` (a bit set over `axes`, never 0):
-/// `<channel>.layer_<axis>_<axis>…`, naming the axes at their end.
-pub fn corner_mask(channel: &str, axes: &[Axis], corner: usize) -> String {
-    let names: Vec<&str> =
-        axes.iter().enumerate().filter(|(i, _)| corner & (1 << i) != 0).map(|(_, a)| a.name()).collect();
-    format!("{channel}.layer_{}", names.join("_"))
-}
-
-/// The weights of the corner layers 1 .. 2^d at a texel whose positions along the `d` axes are
-/// `x`: each corner's multilinear share β_k = Π (x_i or 1 − x_i), over the shares of the
-/// corners stacked below it and itself, β_k / (β_0 + … + β_k). Blending the corners in order
-/// with these weights gives every axis its value exactly.
-pub fn corner_weights(x: &[f32]) -> Vec<f32> {
-    let corners = 1usize << x.len();
-    let share =
-        |k: usize| -> f32 { x.iter().enumerate().map(|(i, &v)| if k & (1 << i) != 0 { v } else { 1.0 - v }).product() };
-    let mut below = share(0);
-    (1..corners)
-        .map(|k| {
-            let beta = share(k);
-            below += beta;
-            if below > 0.0 {
-                beta / below
-            } else {
-                0.0
-            }
-        })
-        .collect()
+/// The map kinds a material needs: one for each of its textures that drives a parameter, and
+/// base colour too where `COLOR_0` tints it.
+pub fn map_kinds(material: &gltf::Material, vertex_colors: bool) -> Vec<MapKind> {
+    use super::textures::{material_textures, Slot};
+    let textures = material_textures(material);
+    let has = |slot: Slot| textures[slot as usize].is_some();
+    let base_color_varies = has(Slot::BaseColor) || vertex_colors;
+    let sheen = extension(material, "KHR_materials_sheen").is_some_and(|ext| sheen_color(ext) != [0.0; 3]);
+    let mut kinds = Vec::new();
+    let mut add = |kind: MapKind, needed: bool| {
+        if needed {
+            kinds.push(kind);
+        }
+    };
+    add(MapKind::BaseColor, base_color_varies);
+    add(MapKind::MetallicRoughness, has(Slot::MetallicRoughness));
+    add(MapKind::Emission, has(Slot::Emissive) && emission(material) != [0.0; 3]);
+    add(MapKind::Clearcoat, has(Slot::Clearcoat));
+    add(MapKind::ClearcoatGloss, has(Slot::ClearcoatRoughness));
+    // The tint follows the base colour, so a varying base colour varies it too.
+    add(MapKind::Sheen, sheen && (has(Slot::SheenColor) || base_color_varies));
+    add(MapKind::Specular, has(Slot::Specular) || has(Slot::SpecularColor));
+    kinds
 }
 
 /// KHR_materials_anisotropy.
@@ -190,142 +224,58 @@ pub fn anisotropy(material: &gltf::Material) -> Option<Anisotropy> {
 /// A glTF material on the Disney parameters.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mapped {
-    /// The preset: the best constant, with each texture at its mean.
+    /// The preset: the factors, where a texture's map multiplies them.
     pub params: Params,
-    /// The textured parameters the look carries through corner layers, in this order.
-    pub axes: Vec<Axis>,
-    /// What the preset cannot hold, one sentence each.
+    /// The maps its textures (and vertex colours) become, in [`MapKind::ALL`] order.
+    pub maps: Vec<MapKind>,
+    /// What the preset and its maps cannot hold, one sentence each.
     pub notes: Vec<String>,
     /// The extensions the material uses that lookdev ignores.
     pub unsupported: Vec<String>,
-}
-
-/// The mean, the least and the greatest of a texture's blue (metallic) and green (roughness).
-fn metal_rough_statistics(image: &image::RgbaImage) -> [(f32, f32, f32); 2] {
-    let mut stats = [(0.0f64, 1.0f32, 0.0f32); 2];
-    for pixel in image.pixels() {
-        for (k, channel) in [2usize, 1].into_iter().enumerate() {
-            let v = pixel.0[channel] as f32 / 255.0;
-            stats[k].0 += v as f64;
-            stats[k].1 = stats[k].1.min(v);
-            stats[k].2 = stats[k].2.max(v);
-        }
-    }
-    let n = (image.width() as f64 * image.height() as f64).max(1.0);
-    stats.map(|(sum, min, max)| ((sum / n) as f32, min, max))
-}
-
-/// sRGB-encoded 8-bit values decoded to linear, as a table.
-pub fn srgb_decode_table() -> [f32; 256] {
-    std::array::from_fn(|i| {
-        let c = i as f64 / 255.0;
-        (if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }) as f32
-    })
-}
-
-/// What a base colour texture (times its factor) holds: its mean linear colour, and its main
-/// colour axis when its colours vary.
-struct ColorStatistics {
-    mean: [f32; 3],
-    /// The axis's ends: the texels projected onto the first principal component span them.
-    axis: Option<([f32; 3], [f32; 3])>,
-    /// The share of the colours' variance along the axis.
-    explained: f32,
-}
-
-/// A colour spread less than this along the main axis (linear units) is a constant.
-const COLOR_VARIATION: f32 = 0.01;
-
-fn color_statistics(image: &image::RgbaImage, factor: [f32; 3]) -> ColorStatistics {
-    let table = srgb_decode_table();
-    let texel = |p: &image::Rgba<u8>| [0, 1, 2].map(|k| (table[p.0[k] as usize] * factor[k]) as f64);
-    let n = (image.width() as f64 * image.height() as f64).max(1.0);
-    let mut sum = [0.0f64; 3];
-    for p in image.pixels() {
-        let c = texel(p);
-        (0..3).for_each(|k| sum[k] += c[k]);
-    }
-    let mean = sum.map(|s| s / n);
-    let mut covariance = [[0.0f64; 3]; 3];
-    for p in image.pixels() {
-        let c = texel(p);
-        for i in 0..3 {
-            for j in 0..3 {
-                covariance[i][j] += (c[i] - mean[i]) * (c[j] - mean[j]) / n;
-            }
-        }
-    }
-    // The first principal component, by power iteration from the diagonal's largest axis.
-    let trace = covariance[0][0] + covariance[1][1] + covariance[2][2];
-    let start = (0..3).max_by(|&a, &b| covariance[a][a].total_cmp(&covariance[b][b])).unwrap_or(0);
-    let mut e = [0.0f64; 3];
-    e[start] = 1.0;
-    for _ in 0..64 {
-        let next: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| covariance[i][j] * e[j]).sum());
-        let length = next.iter().map(|v| v * v).sum::<f64>().sqrt();
-        if length == 0.0 {
-            break;
-        }
-        e = next.map(|v| v / length);
-    }
-    let along = |c: [f64; 3]| (0..3).map(|k| (c[k] - mean[k]) * e[k]).sum::<f64>();
-    let (mut low, mut high) = (f64::MAX, f64::MIN);
-    for p in image.pixels() {
-        let t = along(texel(p));
-        low = low.min(t);
-        high = high.max(t);
-    }
-    let variance_along: f64 = (0..3).map(|i| (0..3).map(|j| e[i] * covariance[i][j] * e[j]).sum::<f64>()).sum();
-    let point = |t: f64| [0, 1, 2].map(|k| (mean[k] + t * e[k]).clamp(0.0, 1.0) as f32);
-    let spread = (high - low) as f32;
-    ColorStatistics {
-        mean: mean.map(|m| m as f32),
-        axis: (spread > COLOR_VARIATION).then(|| (point(low), point(high))),
-        explained: if trace > 0.0 { (variance_along / trace) as f32 } else { 1.0 },
-    }
 }
 
 fn luminance(c: [f32; 3]) -> f32 {
     0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
 }
 
-/// Maps a material (or glTF's default material) onto the Disney parameters.
-pub fn map(asset: &Asset, material: &gltf::Material) -> Mapped {
+/// KHR_materials_sheen's colour factor.
+fn sheen_color(ext: &Value) -> [f32; 3] {
+    ext.get("sheenColorFactor")
+        .and_then(Value::as_array)
+        .map(|a| [0, 1, 2].map(|k| a.get(k).and_then(Value::as_f64).unwrap_or(0.0) as f32))
+        .unwrap_or([0.0; 3])
+}
+
+/// The emitted radiance: `emissiveFactor` × KHR_materials_emissive_strength, within the
+/// format's limit.
+fn emission(material: &gltf::Material) -> [f32; 3] {
+    let strength = extension(material, "KHR_materials_emissive_strength")
+        .and_then(|ext| number(ext, "emissiveStrength"))
+        .unwrap_or(1.0)
+        .max(0.0);
+    material.emissive_factor().map(|f| (f * strength).clamp(0.0, crate::material::params::EMISSION_MAX))
+}
+
+/// GTR1's gloss for the coat's GGX roughness r: the α mix(0.1, 0.001, gloss) matched to r².
+pub fn clearcoat_gloss(roughness: f32) -> f32 {
+    ((0.1 - roughness * roughness) / 0.099).clamp(0.0, 1.0)
+}
+
+/// Maps a material (or glTF's default material) onto the Disney parameters. `vertex_colors`:
+/// whether a primitive with `COLOR_0` uses it.
+pub fn map(material: &gltf::Material, vertex_colors: bool) -> Mapped {
+    use super::textures::{material_textures, Slot};
+    let textures = material_textures(material);
+    let maps = map_kinds(material, vertex_colors);
     let mut notes = Vec::new();
     let pbr = material.pbr_metallic_roughness();
     let factor = pbr.base_color_factor();
-    let mut base_color = [factor[0], factor[1], factor[2]];
-    let mut axes = Vec::new();
-    let (metallic_factor, roughness_factor) = (pbr.metallic_factor(), pbr.roughness_factor());
-    let (mut metallic, mut roughness) = (metallic_factor, roughness_factor);
-    if let Some(info) = pbr.metallic_roughness_texture() {
-        let [(metal_mean, metal_min, metal_max), (rough_mean, rough_min, rough_max)] =
-            metal_rough_statistics(asset.texture_image(&info.texture()));
-        metallic *= metal_mean;
-        roughness *= rough_mean;
-        if metal_max - metal_min > VARIATION {
-            axes.push(Axis::Metallic { factor: metallic_factor });
-        }
-        if rough_max - rough_min > VARIATION {
-            axes.push(Axis::Roughness { factor: roughness_factor });
-        }
-        if !axes.is_empty() {
-            notes.push(
-                "the preset holds the metallic-roughness texture's means; the look layers the texture in through masks"
-                    .into(),
-            );
-        }
-    }
-    if let Some(info) = pbr.base_color_texture() {
-        let statistics = color_statistics(asset.texture_image(&info.texture()), base_color);
-        base_color = statistics.mean;
-        if let Some((from, to)) = statistics.axis {
-            axes.push(Axis::BaseColor { from, to });
-            notes.push(format!(
-                "the preset holds the base colour texture's mean; the look layers the texture in along its main colour axis, which holds {:.0}% of its variance",
-                100.0 * statistics.explained
-            ));
-        }
+    let base_color = [factor[0], factor[1], factor[2]];
+    let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
+    if maps.contains(&MapKind::BaseColor) {
+        notes.push(
+            "base_color is the base colour factor; the look multiplies it by the g-buffer's base colour map".into(),
+        );
     }
 
     // Specular: the dielectric F0 of the IOR, scaled by KHR_materials_specular.
@@ -334,18 +284,24 @@ pub fn map(asset: &Asset, material: &gltf::Material) -> Mapped {
     if let Some(specular) = material.specular() {
         let color = specular.specular_color_factor();
         f0 = (f0 * luminance(color)).min(1.0) * specular.specular_factor();
-        if color.iter().any(|&c| (c - color[0]).abs() > 1e-3) {
-            notes.push(format!(
-                "the specular colour {color:?} is reduced to its luminance: Disney's specular tints only toward the base colour"
-            ));
-        }
-        if specular.specular_texture().is_some() || specular.specular_color_texture().is_some() {
-            notes.push("the specular textures are not carried over".into());
+        if color.iter().any(|&c| (c - color[0]).abs() > 1e-3) || textures[Slot::SpecularColor as usize].is_some() {
+            notes.push(
+                "the specular colour is reduced to its luminance: Disney's specular tints only toward the base colour"
+                    .into(),
+            );
         }
     }
     let specular = clamp_noted(f0 / 0.08, SPECULAR_LIMIT, "specular", &mut notes);
 
-    let mut params = Params { base_color, metallic, roughness, specular, specular_tint: 0.0, ..Params::default() };
+    let mut params = Params {
+        base_color,
+        metallic,
+        roughness,
+        specular,
+        specular_tint: 0.0,
+        emission: emission(material),
+        ..Params::default()
+    };
     params.subsurface = 0.0;
 
     if let Some(ext) = extension(material, "KHR_materials_clearcoat") {
@@ -353,24 +309,18 @@ pub fn map(asset: &Asset, material: &gltf::Material) -> Mapped {
         let coat_roughness = number(ext, "clearcoatRoughnessFactor").unwrap_or(0.0);
         // Disney's clearcoat lobe carries a 0.25 weight: a full glTF coat is clearcoat 4.
         params.clearcoat = clamp_noted(4.0 * strength, CLEARCOAT_LIMIT, "clearcoat", &mut notes);
-        // Matching GTR1's alpha, mix(0.1, 0.001, gloss), to the coat's GGX alpha r².
-        params.clearcoat_gloss = ((0.1 - coat_roughness * coat_roughness) / 0.099).clamp(0.0, 1.0);
-        if ext.get("clearcoatTexture").is_some() || ext.get("clearcoatRoughnessTexture").is_some() {
-            notes.push("the clearcoat textures are not carried over".into());
-        }
+        // Not linear in the texture: the map holds the gloss itself.
+        params.clearcoat_gloss =
+            if maps.contains(&MapKind::ClearcoatGloss) { 1.0 } else { clearcoat_gloss(coat_roughness) };
         if ext.get("clearcoatNormalTexture").is_some() {
             notes.push("the clearcoat normal map is not carried over (the coat uses the base normal)".into());
         }
     }
     if let Some(ext) = extension(material, "KHR_materials_sheen") {
-        let color = ext
-            .get("sheenColorFactor")
-            .and_then(Value::as_array)
-            .map(|a| [0, 1, 2].map(|k| a.get(k).and_then(Value::as_f64).unwrap_or(0.0) as f32))
-            .unwrap_or([0.0; 3]);
-        let strength = luminance(color);
-        params.sheen = clamp_noted(strength, SHEEN_LIMIT, "sheen", &mut notes);
-        params.sheen_tint = sheen_tint(color, base_color);
+        let color = sheen_color(ext);
+        params.sheen = clamp_noted(luminance(color), SHEEN_LIMIT, "sheen", &mut notes);
+        // The tint depends on the base colour: where that is a map, the sheen_tint map holds it.
+        params.sheen_tint = if maps.contains(&MapKind::Sheen) { 1.0 } else { sheen_tint(color, base_color) };
         if let Some(r) = number(ext, "sheenRoughnessFactor") {
             notes.push(format!("sheen roughness {r} has no Disney counterpart (the sheen lobe has one shape)"));
         }
@@ -385,9 +335,6 @@ pub fn map(asset: &Asset, material: &gltf::Material) -> Mapped {
             notes.push("the anisotropy texture is not carried over".into());
         }
     }
-    if material.emissive_factor() != [0.0; 3] || material.emissive_texture().is_some() {
-        notes.push("emission is not carried over: lookdev lights with the environment only".into());
-    }
     if material.occlusion_texture().is_some() {
         notes.push("the occlusion texture is not carried over".into());
     }
@@ -401,7 +348,7 @@ pub fn map(asset: &Asset, material: &gltf::Material) -> Mapped {
     for name in &unsupported {
         notes.push(format!("{name} is not supported"));
     }
-    Mapped { params: clamp_params(params), axes, notes, unsupported }
+    Mapped { params: clamp_params(params), maps, notes, unsupported }
 }
 
 /// Disney's anisotropic, from KHR_materials_anisotropy's strength s at GGX alpha α: the same

@@ -14,22 +14,30 @@ pub mod geometry;
 pub mod import;
 pub mod materials;
 mod names;
+pub mod textures;
 
 pub use names::channel_name;
 
 use crate::{Error, Result};
 use base64::Engine;
+use gltf::json::Value;
 use image::RgbaImage;
 use std::path::{Path, PathBuf};
 
 /// Extensions lookdev reads, for the bake or the material import.
-pub const SUPPORTED_EXTENSIONS: [&str; 5] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 7] = [
     "KHR_materials_ior",
     "KHR_materials_specular",
     "KHR_materials_clearcoat",
     "KHR_materials_sheen",
     "KHR_materials_anisotropy",
+    "KHR_materials_emissive_strength",
+    "KHR_texture_transform",
 ];
+
+/// Texture formats lookdev cannot decode, by the extension that brings them.
+const UNDECODABLE_TEXTURES: [(&str, &str); 3] =
+    [("KHR_texture_basisu", "KTX2"), ("EXT_texture_webp", "WebP"), ("MSFT_texture_dds", "DDS")];
 
 /// Mesh compression extensions, which lookdev cannot decode.
 const COMPRESSION: [(&str, &str); 3] = [
@@ -55,6 +63,7 @@ impl Asset {
         let gltf = gltf::Gltf::from_slice_without_validation(&bytes)
             .map_err(|e| Error::input_file(path, format!("not a readable glTF file ({e})")))?;
         let blob = gltf.blob;
+        check_texture_formats(path, gltf.document.as_json())?;
         check_required_extensions(path, &gltf.document)?;
         // Required extensions are checked above; everything else is validated as usual.
         let mut json = gltf.document.into_json();
@@ -67,21 +76,68 @@ impl Asset {
             .map(|buffer| load_buffer(path, folder, &buffer, blob.as_deref()))
             .collect::<Result<Vec<_>>>()?;
         let mut asset = Asset { path: path.to_path_buf(), document, buffers, images: Vec::new() };
+        asset.check_extension_textures()?;
         asset.images = asset.load_images(folder)?;
         Ok(asset)
+    }
+
+    /// The extensions' textureInfos are JSON the `gltf` crate does not check: each must name a
+    /// texture of the file, and a texcoord set the bake reads.
+    fn check_extension_textures(&self) -> Result<()> {
+        let count = self.document.textures().len();
+        for material in self.document.materials() {
+            let label = material_label(&material);
+            for slot in textures::Slot::ALL {
+                let Some(info) = textures::slot_json(&material, slot) else { continue };
+                match textures::TextureRef::from_json(info) {
+                    Some(reference) if reference.texture < count => {}
+                    Some(reference) => {
+                        return Err(Error::input_file(
+                            &self.path,
+                            format!(
+                                "{label}: {} names texture {}, and the file has {count}",
+                                slot.key(),
+                                reference.texture
+                            ),
+                        ))
+                    }
+                    None => {
+                        return Err(Error::input_file(
+                            &self.path,
+                            format!("{label}: {} has no valid texture index", slot.key()),
+                        ))
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The texture references of a material that name a texcoord set beyond TEXCOORD_1, which
+    /// the bake does not read: each is sampled with TEXCOORD_0 instead, and reported.
+    pub fn unread_texcoords(&self) -> Vec<String> {
+        let mut found = Vec::new();
+        for material in self.document.materials() {
+            for (slot, reference) in textures::Slot::ALL.iter().zip(textures::material_textures(&material)) {
+                if let Some(reference) = reference.filter(|r| r.tex_coord > 1) {
+                    found.push(format!(
+                        "{}: {} uses TEXCOORD_{}, which is not read; TEXCOORD_0 is used",
+                        material_label(&material),
+                        slot.key(),
+                        reference.tex_coord
+                    ));
+                }
+            }
+        }
+        found
     }
 
     /// The images materials use, decoded.
     fn load_images(&self, folder: &Path) -> Result<Vec<Option<RgbaImage>>> {
         let mut used = vec![false; self.document.images().len()];
         for material in self.document.materials() {
-            let pbr = material.pbr_metallic_roughness();
-            let textures = [
-                pbr.base_color_texture().map(|t| t.texture()),
-                pbr.metallic_roughness_texture().map(|t| t.texture()),
-                material.normal_texture().map(|t| t.texture()),
-            ];
-            for texture in textures.into_iter().flatten() {
+            for reference in textures::material_textures(&material).into_iter().flatten() {
+                let texture = self.document.textures().nth(reference.texture).expect("checked on load");
                 used[texture.source().index()] = true;
             }
         }
@@ -131,6 +187,65 @@ impl Asset {
             .map(|name| name.to_string())
             .collect()
     }
+}
+
+/// "material 3 'paint'", as messages name a material.
+pub fn material_label(material: &gltf::Material) -> String {
+    match (material.index(), material.name()) {
+        (Some(i), Some(name)) => format!("material {i} '{name}'"),
+        (Some(i), None) => format!("material {i}"),
+        (None, _) => "the default material".to_string(),
+    }
+}
+
+/// Textures in a format lookdev cannot decode (KTX2 / Basis Universal, WebP, DDS) are refused
+/// before anything else, naming the image, its URI and the extension: the `gltf` crate would
+/// only say that a texture lacks its source. A texture that also gives a plain `source` (a PNG
+/// or JPEG fallback) uses that.
+fn check_texture_formats(path: &Path, json: &gltf::json::Root) -> Result<()> {
+    let image_label = |index: u64| -> String {
+        let Some(image) = usize::try_from(index).ok().and_then(|i| json.images.get(i)) else {
+            return format!("image {index}");
+        };
+        let name = image.name.as_deref().map(|n| format!(" '{n}'")).unwrap_or_default();
+        let uri = match (&image.uri, &image.mime_type) {
+            (Some(uri), _) if !uri.starts_with("data:") => format!(" ({uri})"),
+            (_, Some(mime)) => format!(" (embedded, {})", mime.0),
+            _ => " (embedded)".to_string(),
+        };
+        format!("image {index}{name}{uri}")
+    };
+    let refuse = |texture: usize, image: String, format: &str, extension: &str| {
+        Error::input_file(
+            path,
+            format!(
+                "texture {texture} uses {image} in {format} format ({extension}), which lookdev cannot decode; \
+                 convert the textures to PNG or JPEG"
+            ),
+        )
+    };
+    for (index, texture) in json.textures.iter().enumerate() {
+        let source = texture.source.value();
+        match json.images.get(source) {
+            Some(image) => {
+                let mime = image.mime_type.as_ref().map(|m| m.0.as_str());
+                let uri = image.uri.as_deref().unwrap_or("").to_ascii_lowercase();
+                if mime == Some("image/ktx2") || uri.ends_with(".ktx2") {
+                    return Err(refuse(index, image_label(source as u64), "KTX2", "KHR_texture_basisu"));
+                }
+            }
+            None => {
+                let extensions = texture.extensions.as_ref().map(|e| &e.others);
+                for (extension, format) in UNDECODABLE_TEXTURES {
+                    if let Some(ext) = extensions.and_then(|e| e.get(extension)) {
+                        let image = ext.get("source").and_then(Value::as_u64).map_or("an image".into(), image_label);
+                        return Err(refuse(index, image, format, extension));
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 fn check_required_extensions(path: &Path, document: &gltf::Document) -> Result<()> {

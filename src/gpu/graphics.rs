@@ -3,7 +3,7 @@
 //! images that stay in the GENERAL layout like every other image.
 
 use super::context::{Context, Shared};
-use super::memory::Image;
+use super::memory::{Buffer, Image};
 use super::shaders::Stage;
 use crate::{Error, Result};
 use ash::vk;
@@ -26,7 +26,8 @@ pub struct PipelineDesc<'a> {
     pub attributes: &'a [Attribute],
     pub color_formats: &'a [vk::Format],
     pub depth_format: vk::Format,
-    /// Combined image samplers in descriptor set 0, bindings 0..textures.
+    /// An array of this many combined image samplers at descriptor set 0, binding 0, which the
+    /// fragment stage samples; then, at binding 1, one storage buffer both stages read.
     pub textures: u32,
     /// Bytes of push constants, seen by both stages.
     pub push_size: u32,
@@ -54,15 +55,18 @@ fn module(ctx: &Context, stage: &Stage) -> Result<vk::ShaderModule> {
 impl GraphicsPipeline {
     pub fn new(ctx: &Context, desc: &PipelineDesc) -> Result<GraphicsPipeline> {
         let device = &ctx.device;
-        let bindings: Vec<_> = (0..desc.textures)
-            .map(|i| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(i)
-                    .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::FRAGMENT)
-            })
-            .collect();
+        let bindings = [
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(0)
+                .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                .descriptor_count(desc.textures)
+                .stage_flags(vk::ShaderStageFlags::FRAGMENT),
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(1)
+                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                .descriptor_count(1)
+                .stage_flags(STAGES),
+        ];
         let set_layout = unsafe {
             device.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None)
         }?;
@@ -165,13 +169,17 @@ impl GraphicsPipeline {
         Ok(result)
     }
 
-    /// A descriptor set binding `textures` (image and sampler) at bindings 0, 1, ...
-    pub fn texture_set(&self, textures: &[(&Image, &Sampler)]) -> Result<TextureSet> {
+    /// A descriptor set binding `textures` (image and sampler) as the array at binding 0, and
+    /// `buffer` at binding 1.
+    pub fn texture_set(&self, textures: &[(&Image, &Sampler)], buffer: &Buffer) -> Result<TextureSet> {
         assert_eq!(textures.len() as u32, self.textures, "the pipeline takes {} textures", self.textures);
         let device = &self.shared.device;
-        let sizes = [vk::DescriptorPoolSize::default()
-            .ty(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-            .descriptor_count(self.textures.max(1))];
+        let sizes = [
+            vk::DescriptorPoolSize::default()
+                .ty(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                .descriptor_count(self.textures.max(1)),
+            vk::DescriptorPoolSize::default().ty(vk::DescriptorType::STORAGE_BUFFER).descriptor_count(1),
+        ];
         let pool = unsafe {
             device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None)
         }?;
@@ -183,26 +191,28 @@ impl GraphicsPipeline {
             )
         }?[0];
         result.set = set;
-        let infos: Vec<[vk::DescriptorImageInfo; 1]> = textures
+        let infos: Vec<vk::DescriptorImageInfo> = textures
             .iter()
             .map(|(image, sampler)| {
-                [vk::DescriptorImageInfo::default()
+                vk::DescriptorImageInfo::default()
                     .sampler(sampler.sampler)
                     .image_view(image.view)
-                    .image_layout(vk::ImageLayout::GENERAL)]
+                    .image_layout(vk::ImageLayout::GENERAL)
             })
             .collect();
-        let writes: Vec<_> = infos
-            .iter()
-            .enumerate()
-            .map(|(i, info)| {
-                vk::WriteDescriptorSet::default()
-                    .dst_set(set)
-                    .dst_binding(i as u32)
-                    .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-                    .image_info(info)
-            })
-            .collect();
+        let buffer_info = [vk::DescriptorBufferInfo::default().buffer(buffer.buffer).range(vk::WHOLE_SIZE)];
+        let writes = [
+            vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(0)
+                .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                .image_info(&infos),
+            vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(1)
+                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                .buffer_info(&buffer_info),
+        ];
         unsafe { device.update_descriptor_sets(&writes, &[]) };
         Ok(result)
     }
@@ -268,20 +278,23 @@ impl Drop for TextureSet {
 }
 
 /// How a texture is filtered and wrapped.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct SamplerDesc {
     pub magnify: vk::Filter,
     pub minify: vk::Filter,
+    /// Between mip levels; `None` samples the full-size level only.
+    pub mipmap: Option<vk::SamplerMipmapMode>,
     pub wrap_u: vk::SamplerAddressMode,
     pub wrap_v: vk::SamplerAddressMode,
 }
 
 impl Default for SamplerDesc {
-    /// glTF's defaults: linear filtering, repeating.
+    /// Trilinear filtering, repeating: glTF's defaults where a sampler leaves them open.
     fn default() -> Self {
         SamplerDesc {
             magnify: vk::Filter::LINEAR,
             minify: vk::Filter::LINEAR,
+            mipmap: Some(vk::SamplerMipmapMode::LINEAR),
             wrap_u: vk::SamplerAddressMode::REPEAT,
             wrap_v: vk::SamplerAddressMode::REPEAT,
         }
@@ -302,7 +315,8 @@ impl Sampler {
             .address_mode_u(desc.wrap_u)
             .address_mode_v(desc.wrap_v)
             .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .max_lod(0.0);
+            .mipmap_mode(desc.mipmap.unwrap_or(vk::SamplerMipmapMode::NEAREST))
+            .max_lod(if desc.mipmap.is_some() { vk::LOD_CLAMP_NONE } else { 0.0 });
         let sampler = unsafe { ctx.device.create_sampler(&info, None) }?;
         Ok(Sampler { shared: ctx.shared.clone(), sampler })
     }

@@ -192,6 +192,8 @@ pub struct Image {
     pub width: u32,
     pub height: u32,
     pub layers: u32,
+    /// Mip levels: 1 but for textures made with [`Image::texture`].
+    levels: u32,
     aspect: vk::ImageAspectFlags,
 }
 
@@ -200,7 +202,11 @@ pub fn texel_size(format: vk::Format) -> u64 {
     match format {
         vk::Format::R32G32B32A32_SFLOAT => 16,
         vk::Format::R32G32_SFLOAT | vk::Format::R32G32_UINT => 8,
-        vk::Format::R32_SFLOAT | vk::Format::R32_UINT | vk::Format::R8G8B8A8_UNORM | vk::Format::D32_SFLOAT => 4,
+        vk::Format::R32_SFLOAT
+        | vk::Format::R32_UINT
+        | vk::Format::R8G8B8A8_UNORM
+        | vk::Format::R8G8B8A8_SRGB
+        | vk::Format::D32_SFLOAT => 4,
         other => panic!("texel_size: format {other:?} is not used by lookdev"),
     }
 }
@@ -227,10 +233,45 @@ impl Image {
         Image::create(ctx, vk::Format::D32_SFLOAT, width, height, 1, false, Purpose::DepthTarget)
     }
 
-    /// A sampled RGBA8 texture (linear values: no sRGB decoding) holding `rgba`.
-    pub fn texture(ctx: &Context, width: u32, height: u32, rgba: &[u8]) -> Result<Image> {
-        let image = Image::create(ctx, vk::Format::R8G8B8A8_UNORM, width, height, 1, false, Purpose::Texture)?;
-        image.upload(ctx, rgba)?;
+    /// A sampled RGBA8 texture holding `levels`, its mip chain from the full size down, each
+    /// level tightly packed. An sRGB texture is decoded to linear by the sampler, before
+    /// filtering; any other is sampled as stored.
+    pub fn texture(ctx: &Context, levels: &[image::RgbaImage], srgb: bool) -> Result<Image> {
+        let format = if srgb { vk::Format::R8G8B8A8_SRGB } else { vk::Format::R8G8B8A8_UNORM };
+        let (width, height) = levels[0].dimensions();
+        let image = Image::create_levels(ctx, format, width, height, 1, false, Purpose::Texture, levels.len() as u32)?;
+        let total: usize = levels.iter().map(|l| l.as_raw().len()).sum();
+        let mut staging = Buffer::staging(ctx, total as u64)?;
+        let mut regions = Vec::with_capacity(levels.len());
+        let mut offset = 0usize;
+        for (level, pixels) in levels.iter().enumerate() {
+            let bytes = pixels.as_raw();
+            staging.bytes_mut()[offset..offset + bytes.len()].copy_from_slice(bytes);
+            regions.push(
+                vk::BufferImageCopy::default()
+                    .buffer_offset(offset as u64)
+                    .image_subresource(
+                        vk::ImageSubresourceLayers::default()
+                            .aspect_mask(vk::ImageAspectFlags::COLOR)
+                            .mip_level(level as u32)
+                            .layer_count(1),
+                    )
+                    .image_extent(vk::Extent3D { width: pixels.width(), height: pixels.height(), depth: 1 }),
+            );
+            offset += bytes.len();
+        }
+        ctx.run(|cmd| {
+            unsafe {
+                ctx.device.cmd_copy_buffer_to_image(
+                    cmd,
+                    staging.buffer,
+                    image.image,
+                    vk::ImageLayout::GENERAL,
+                    &regions,
+                )
+            };
+            Ok(())
+        })?;
         Ok(image)
     }
 
@@ -243,6 +284,20 @@ impl Image {
         array: bool,
         purpose: Purpose,
     ) -> Result<Image> {
+        Image::create_levels(ctx, format, width, height, layers, array, purpose, 1)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn create_levels(
+        ctx: &Context,
+        format: vk::Format,
+        width: u32,
+        height: u32,
+        layers: u32,
+        array: bool,
+        purpose: Purpose,
+        levels: u32,
+    ) -> Result<Image> {
         let sampled_as_srgb = purpose == Purpose::Display;
         let max = ctx.info().max_image_dimension_2d;
         if width == 0 || height == 0 || width > max || height > max {
@@ -254,7 +309,7 @@ impl Image {
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
             .extent(vk::Extent3D { width, height, depth: 1 })
-            .mip_levels(1)
+            .mip_levels(levels)
             .array_layers(layers)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
@@ -274,6 +329,7 @@ impl Image {
             width,
             height,
             layers,
+            levels,
             aspect: purpose.aspect(),
         };
         let device = &result.shared.device;
@@ -301,7 +357,7 @@ impl Image {
     }
 
     fn range(&self) -> vk::ImageSubresourceRange {
-        vk::ImageSubresourceRange::default().aspect_mask(self.aspect).level_count(1).layer_count(self.layers)
+        vk::ImageSubresourceRange::default().aspect_mask(self.aspect).level_count(self.levels).layer_count(self.layers)
     }
 
     fn transition_to_general(&self, cmd: vk::CommandBuffer) {

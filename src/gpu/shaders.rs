@@ -45,8 +45,10 @@ macro_rules! stage {
 
 /// The bake's vertex stage: world-space vertices to clip space.
 pub const BAKE_VERTEX: Stage = stage!("bake.vert");
-/// The bake's fragment stage: one g-buffer sample of the nearest surface.
+/// The bake's geometry pass: one g-buffer sample of the nearest surface.
 pub const BAKE_FRAGMENT: Stage = stage!("bake.frag");
+/// The bake's maps pass: the same surfaces' textures as parameter maps.
+pub const BAKE_MAPS_FRAGMENT: Stage = stage!("bake_maps.frag");
 
 /// Every graphics stage.
-pub const STAGES: [&Stage; 2] = [&BAKE_VERTEX, &BAKE_FRAGMENT];
+pub const STAGES: [&Stage; 3] = [&BAKE_VERTEX, &BAKE_FRAGMENT, &BAKE_MAPS_FRAGMENT];
