@@ -364,6 +364,148 @@ fn vertex_colours_and_textures_become_masks_and_maps_that_the_look_binds() {
     }
 }
 
+/// A 2×1 texture: `left` on the left half of the image, `right` on the right.
+fn halves(left: [u8; 4], right: [u8; 4]) -> image::RgbaImage {
+    image::RgbaImage::from_fn(2, 1, |x, _| image::Rgba(if x == 0 { left } else { right }))
+}
+
+#[test]
+fn the_extensions_textures_become_maps_in_disney_units_that_the_look_binds() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut gltf = Gltf::new();
+    for name in ["KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_specular"] {
+        gltf.uses_extension(name);
+    }
+    let coat = gltf.texture(&halves([153, 0, 0, 255], [51, 0, 0, 255]));
+    let coat_roughness = gltf.texture(&halves([0, 255, 0, 255], [0, 102, 0, 255]));
+    // Sheen and specular colours are sRGB; the specular texture's weight is its alpha.
+    let sheen = gltf.texture(&halves([255, 255, 255, 255], [255, 128, 0, 255]));
+    let specular = gltf.texture(&halves([0, 0, 0, 255], [0, 0, 0, 64]));
+    let specular_color = gltf.texture(&halves([255, 255, 255, 255], [0, 255, 0, 255]));
+    let base = gltf.texture(&halves([200, 200, 200, 255], [90, 180, 250, 255]));
+    gltf.json["samplers"] = json!([{ "magFilter": 9728, "minFilter": 9728 }]);
+    for texture in [coat, coat_roughness, sheen, specular, specular_color, base] {
+        gltf.json["textures"][texture]["sampler"] = json!(0);
+    }
+    let material = gltf.material(json!({
+        "name": "coated",
+        "pbrMetallicRoughness": { "baseColorTexture": { "index": base } },
+        "extensions": {
+            "KHR_materials_clearcoat": {
+                "clearcoatFactor": 0.5, "clearcoatTexture": { "index": coat },
+                "clearcoatRoughnessFactor": 0.5, "clearcoatRoughnessTexture": { "index": coat_roughness }
+            },
+            "KHR_materials_sheen": { "sheenColorFactor": [0.8, 0.4, 0.2], "sheenColorTexture": { "index": sheen } },
+            "KHR_materials_specular": {
+                "specularFactor": 1.0, "specularTexture": { "index": specular },
+                "specularColorFactor": [1.0, 0.5, 0.5], "specularColorTexture": { "index": specular_color }
+            }
+        }
+    }));
+    let mesh = gltf.mesh("plane", &[(&plane(1.0), Some(material))]);
+    gltf.node(json!({ "name": "plane", "mesh": mesh }));
+    camera_looking_down_z(&mut gltf, "front", [0.0, 0.0, 1.0 / 20f32.to_radians().tan()], 40.0, 1.0);
+    let path = gltf.write_gltf(dir.path(), "coated");
+    let g = bake_file(&path, 32, 4);
+    let maps: Vec<&str> = g.maps.keys().map(String::as_str).collect();
+    assert_eq!(
+        maps,
+        [
+            "base_color.B",
+            "base_color.G",
+            "base_color.R",
+            "clearcoat",
+            "clearcoat_gloss",
+            "sheen",
+            "sheen_tint",
+            "specular"
+        ]
+    );
+    let luminance = |c: [f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    let gloss = |r: f32| ((0.1 - r * r) / 0.099f32).clamp(0.0, 1.0);
+    let srgb = |c: u8| srgb_to_linear(c);
+    for (x, left) in [(8usize, true), (24, false)] {
+        let at = |name: &str| g.maps[name][16 * 32 + x];
+        let close = |name: &str, want: f32| {
+            assert!((at(name) - want).abs() < 0.01, "{name} at x = {x}: {} vs {want}", at(name))
+        };
+        close("clearcoat", if left { 0.6 } else { 0.2 });
+        close("clearcoat_gloss", gloss(0.5 * if left { 1.0 } else { 0.4 }));
+        let sheen_colour = if left { [1.0, 1.0, 1.0] } else { [1.0, srgb(128), 0.0] };
+        let factor = [0.8, 0.4, 0.2];
+        let sheen = [0, 1, 2].map(|k| factor[k] * sheen_colour[k]);
+        close("sheen", luminance(sheen) / luminance(factor));
+        let base = if left { [srgb(200); 3] } else { [srgb(90), srgb(180), srgb(250)] };
+        close("sheen_tint", lookdev::asset::materials::sheen_tint(sheen, base));
+        let weight = if left { 1.0 } else { 64.0 / 255.0 };
+        let colour_factor = [1.0, 0.5, 0.5];
+        let colour = if left { 1.0 } else { luminance([0.0, 0.5, 0.0]) / luminance(colour_factor) };
+        close("specular", weight * colour);
+    }
+    // The preset holds the factors (and 1 where the map holds the value itself); the look binds.
+    let asset = Asset::load(&path).unwrap();
+    let import = Import::new(&asset).unwrap();
+    let p = import.materials[0].preset.params;
+    assert_eq!((p.clearcoat, p.clearcoat_gloss, p.sheen_tint), (2.0, 1.0, 1.0));
+    assert!((p.sheen - luminance([0.8, 0.4, 0.2])).abs() < 1e-6);
+    let look = import.look(&dir.path().join("coated.toml"), str::to_string);
+    let bound: Vec<&str> = look.objects[0].layers[0].maps.values().map(String::as_str).collect();
+    assert_eq!(bound, ["base_color", "specular", "sheen", "sheen_tint", "clearcoat", "clearcoat_gloss"]);
+}
+
+#[test]
+fn undecodable_textures_are_refused_naming_the_image_its_uri_and_the_extension() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("g.exr").to_string_lossy().into_owned();
+    let presets = dir.path().join("presets").to_string_lossy().into_owned();
+    let look = dir.path().join("look.toml").to_string_lossy().into_owned();
+    // A Basis texture with no fallback: bake and import both refuse it.
+    let basis = broken_asset(dir.path(), "basis", |g| {
+        g.uses_extension("KHR_texture_basisu");
+        g.json["extensionsRequired"] = json!(["KHR_texture_basisu"]);
+        g.json["images"] = json!([{ "uri": "albedo.ktx2", "name": "albedo" }]);
+        g.json["textures"] = json!([{ "extensions": { "KHR_texture_basisu": { "source": 0 } } }]);
+        g.json["materials"] = json!([{ "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 } } }]);
+        g.json["meshes"][0]["primitives"][0]["material"] = json!(0);
+    });
+    let fragments = ["basis.gltf", "texture 0", "image 0 'albedo' (albedo.ktx2)", "KTX2", "KHR_texture_basisu"];
+    assert_bad_input(&lookdev(&["bake", &basis, "--out", &out, "--size", "16", "16"]), &fragments);
+    assert_bad_input(&lookdev(&["import", &basis, "--presets", &presets, "--look", &look]), &fragments);
+    // A KTX2 image given as the plain source is refused the same way.
+    let plain = broken_asset(dir.path(), "plain", |g| {
+        g.json["images"] = json!([{ "uri": "albedo.ktx2" }]);
+        g.json["textures"] = json!([{ "source": 0 }]);
+        g.json["materials"] = json!([{ "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 } } }]);
+        g.json["meshes"][0]["primitives"][0]["material"] = json!(0);
+    });
+    assert_bad_input(
+        &lookdev(&["bake", &plain, "--out", &out, "--size", "16", "16"]),
+        &["plain.gltf", "albedo.ktx2", "KTX2"],
+    );
+    assert!(!Path::new(&out).exists(), "no g-buffer is written for bad input");
+
+    // With a PNG fallback as its source, the texture bakes from that; a texture on a texcoord
+    // set beyond TEXCOORD_1 is sampled with TEXCOORD_0 and reported.
+    let mut gltf = Gltf::new();
+    gltf.uses_extension("KHR_texture_basisu");
+    let texture = gltf.texture(&halves([255, 0, 0, 255], [0, 0, 255, 255]));
+    gltf.json["textures"][texture]["extensions"] = json!({ "KHR_texture_basisu": { "source": 7 } });
+    let material = gltf.material(json!({
+        "pbrMetallicRoughness": { "baseColorTexture": { "index": texture } },
+        "emissiveTexture": { "index": texture, "texCoord": 2 },
+        "emissiveFactor": [1.0, 1.0, 1.0]
+    }));
+    let mesh = gltf.mesh("plane", &[(&plane(1.0), Some(material))]);
+    gltf.node(json!({ "name": "plane", "mesh": mesh }));
+    camera_looking_down_z(&mut gltf, "front", [0.0, 0.0, 1.0 / 20f32.to_radians().tan()], 40.0, 1.0);
+    let fallback = gltf.write_gltf(dir.path(), "fallback").to_string_lossy().into_owned();
+    let output = lookdev(&["bake", &fallback, "--out", &out, "--size", "16", "16", "--samples", "1"]);
+    assert_success(&output);
+    assert!(stderr(&output).contains("emissiveTexture uses TEXCOORD_2, which is not read"), "{}", stderr(&output));
+    let g = GBuffer::read(Path::new(&out)).unwrap();
+    assert!(g.maps["base_color.R"][8 * 16 + 4] > 0.9 && g.maps["base_color.B"][8 * 16 + 12] > 0.9);
+}
+
 #[test]
 fn the_mapping_holds_for_every_listed_extension_and_unsupported_ones_are_named() {
     let dir = tempfile::tempdir().unwrap();
@@ -374,6 +516,7 @@ fn the_mapping_holds_for_every_listed_extension_and_unsupported_ones_are_named()
         "KHR_materials_clearcoat",
         "KHR_materials_sheen",
         "KHR_materials_anisotropy",
+        "KHR_materials_emissive_strength",
         "KHR_materials_transmission",
     ] {
         gltf.uses_extension(name);
@@ -381,7 +524,9 @@ fn the_mapping_holds_for_every_listed_extension_and_unsupported_ones_are_named()
     let material = gltf.material(json!({
         "name": "Lacquer.01",
         "pbrMetallicRoughness": { "baseColorFactor": [0.5, 0.25, 0.1, 1.0], "metallicFactor": 0.2, "roughnessFactor": 0.6 },
+        "emissiveFactor": [1.0, 0.5, 0.25],
         "extensions": {
+            "KHR_materials_emissive_strength": { "emissiveStrength": 6.0 },
             "KHR_materials_ior": { "ior": 1.8 },
             "KHR_materials_specular": { "specularFactor": 0.5, "specularColorFactor": [1.0, 1.0, 1.0] },
             "KHR_materials_clearcoat": { "clearcoatFactor": 0.5, "clearcoatRoughnessFactor": 0.2 },
@@ -417,6 +562,9 @@ fn the_mapping_holds_for_every_listed_extension_and_unsupported_ones_are_named()
     // Disney's alpha ratio 1/(1 − 0.9·anisotropic) equals glTF's stretch mix(α, 1, s²)/α.
     let alpha = 0.6f32 * 0.6;
     close(1.0 / (1.0 - 0.9 * p.anisotropic), (alpha + 0.36 * (1.0 - alpha)) / alpha, "anisotropy ratio");
+    // Emission: emissiveFactor × KHR_materials_emissive_strength.
+    assert_eq!(p.emission, [6.0, 3.0, 1.5]);
+    assert!(imported.mapped.maps.is_empty(), "no textures, no maps");
     assert!(
         imported.mapped.notes.iter().any(|n| n.contains("KHR_materials_transmission")),
         "{:?}",

@@ -81,6 +81,9 @@ fn every_kind_of_edit() -> Vec<Edit> {
         Edit::SetEnabled { object: BALL, layer: 0, enabled: false },
         Edit::SetMask { object: BALL, layer: 1, mask: Some("grunge".into()) },
         Edit::SetMask { object: BALL, layer: 1, mask: None },
+        Edit::SetMap { object: BALL, layer: 1, param: Param::BaseColor, map: Some("albedo".into()) },
+        Edit::SetMap { object: BALL, layer: 1, param: Param::Roughness, map: Some("metalRough.G".into()) },
+        Edit::SetMap { object: BALL, layer: 1, param: Param::BaseColor, map: None },
         Edit::SetInvert { object: BALL, layer: 2, invert: true },
         Edit::SetOpacity { object: BALL, layer: 2, opacity: 0.25 },
         Edit::SetParam { object: ObjectRef::Default, layer: 0, param: Param::Sheen, value: Value::Scalar(1.5) },
@@ -121,6 +124,32 @@ fn every_edit_applies_as_one_step_and_undoes_and_redoes_exactly() {
     assert!(!doc.can_undo(), "one step per edit");
     assert_eq!(snapshot(&doc), start);
     assert!(!doc.is_dirty());
+}
+
+#[test]
+fn map_bindings_keep_the_value_as_the_factor_and_refuse_empty_names() {
+    let mut doc = document();
+    let gold = |doc: &Document| doc.stack(BALL).unwrap().layers[1].clone();
+    let before = gold(&doc);
+    doc.apply(Edit::SetMap { object: BALL, layer: 1, param: Param::Metallic, map: Some("metal".into()) }).unwrap();
+    let bound = gold(&doc);
+    assert_eq!(bound.maps.get(&Param::Metallic).map(String::as_str), Some("metal"));
+    assert_eq!(bound.params, before.params, "binding keeps the value, as the factor");
+    assert!(doc.is_dirty());
+    // Binding it again to the same map, and refused bindings, record nothing: one undo unbinds.
+    doc.apply(Edit::SetMap { object: BALL, layer: 1, param: Param::Metallic, map: Some("metal".into()) }).unwrap();
+    for bad in ["", " metal", "metal "] {
+        let edit = Edit::SetMap { object: BALL, layer: 1, param: Param::Metallic, map: Some(bad.into()) };
+        assert!(doc.apply(edit).is_err(), "{bad:?}");
+        assert_eq!(gold(&doc), bound, "a refused binding changes nothing");
+    }
+    assert!(doc.undo());
+    assert_eq!(gold(&doc), before);
+    assert!(!doc.can_undo() && !doc.is_dirty(), "one step, and the look is as loaded");
+    assert!(doc.redo());
+    doc.apply(Edit::SetMap { object: BALL, layer: 1, param: Param::Metallic, map: None }).unwrap();
+    assert_eq!(gold(&doc), before);
+    assert!(!doc.is_dirty(), "unbound again, the look is as loaded");
 }
 
 #[test]

@@ -274,6 +274,66 @@ fn turntable_frames_are_independent_of_how_the_range_is_split() {
 }
 
 #[test]
+fn lint_knows_the_maps_and_presets_saved_from_a_bound_layer_keep_their_factors() {
+    let s = Setup::new();
+    // A white factor times a map: no finding on its own, whatever the map holds.
+    let look = s.write(
+        "bound.toml",
+        "[[object]]\n[[object.layer]]\n[object.layer.set]\nbase_color = [1.0, 1.0, 1.0]\nmetallic = 1.0\n\
+         [object.layer.map]\nbase_color = \"tex\"\nmetallic = \"metal\"\n",
+    );
+    let o = s.run(&["lint", &look]);
+    assert!(o.status.success() && stdout(&o).is_empty(), "{}{}", stdout(&o), stderr(&o));
+
+    // With the g-buffer: its pixels are checked with the maps. Half of the covered pixels are
+    // half metal, a tenth are dark dielectric.
+    let mut g = lookdev::gbuffer::GBuffer::shaderball(32, 32);
+    let covered: Vec<usize> = (0..g.pixel_count()).filter(|&i| g.coverage[i] > 0.0).collect();
+    let n = g.pixel_count();
+    g.maps.insert("tex.R".into(), vec![0.5; n]);
+    g.maps.insert("tex.G".into(), vec![0.5; n]);
+    g.maps.insert("tex.B".into(), vec![0.5; n]);
+    g.maps.insert("metal".into(), vec![1.0; n]);
+    for (k, &i) in covered.iter().enumerate() {
+        if k % 2 == 0 {
+            g.maps.get_mut("metal").unwrap()[i] = 0.5;
+        }
+    }
+    g.write(&s.path("g.exr")).unwrap();
+    let o = s.run(&["lint", &look, "--gbuffer", &s.arg("g.exr")]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(
+        out.contains(&format!(
+            "bound.toml:2: default stack, layer 0: with its maps, 50.0% of the {} pixels",
+            covered.len()
+        )),
+        "{out}"
+    );
+    assert!(out.contains("metallic = 0.5 is in between"), "{out}");
+    assert_eq!(out.lines().count(), 1, "{out}");
+    // A map the g-buffer lacks is an error, as for a render.
+    let missing = s.write("missing.toml", "[[object]]\n[[object.layer]]\n[object.layer.map]\nroughness = \"rough\"\n");
+    let o = s.run(&["lint", &missing, "--gbuffer", &s.arg("g.exr")]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("missing.toml:2: map 'rough' (bound to roughness) is not in the g-buffer"),
+        "{}",
+        stderr(&o)
+    );
+
+    // Saved as a preset, the bound layer keeps its constants, and says the maps were dropped.
+    let o = ok(s.run(&["presets", "save", "factors", "--from-look", &look, "--object", "default", "--layer", "0"]));
+    assert!(
+        stderr(&o).contains("dropped the maps of base_color (map 'tex'), metallic (map 'metal')"),
+        "{}",
+        stderr(&o)
+    );
+    let saved = lookdev::material::Preset::load(&s.library().join("factors.toml")).unwrap();
+    assert_eq!((saved.params.base_color, saved.params.metallic), ([1.0; 3], 1.0));
+}
+
+#[test]
 fn lint_reports_implausible_values_with_reasons_and_passes_clean_looks() {
     let s = Setup::new();
     let clean = s.write(

@@ -253,6 +253,88 @@ fn a_scripted_edit_changes_the_image_and_is_saved_to_the_look() {
     assert_differs(&shot, &case.render("look.toml", 4, "original.png"), "edited vs original");
 }
 
+/// The case's g-buffer with maps: the colour map `tex` (a hue across the image) and the scalar
+/// map `rough` (the grunge mask).
+fn write_mapped_gbuffer(case: &Case) -> GBuffer {
+    let mut gbuffer = GBuffer::shaderball(SIZE, SIZE);
+    let n = gbuffer.pixel_count();
+    let at = |i: usize| ((i as u32 % SIZE) as f32 / SIZE as f32, (i as u32 / SIZE) as f32 / SIZE as f32);
+    gbuffer.maps.insert("tex.R".into(), (0..n).map(|i| at(i).0).collect());
+    gbuffer.maps.insert("tex.G".into(), (0..n).map(|i| at(i).1).collect());
+    gbuffer.maps.insert("tex.B".into(), (0..n).map(|i| 1.0 - at(i).0).collect());
+    gbuffer.maps.insert("rough".into(), gbuffer.masks["grunge"].clone());
+    gbuffer.write(&case.path("g.exr")).unwrap();
+    GBuffer::read(&case.path("g.exr")).unwrap()
+}
+
+#[test]
+fn scripted_map_bindings_undo_exactly_and_save_exactly_what_is_bound() {
+    let Some(case) = Case::new() else { return };
+    let gbuffer = write_mapped_gbuffer(&case);
+    let ball = (0..gbuffer.pixel_count()).find(|&i| gbuffer.object_id[i] == 1 && gbuffer.coverage[i] == 1.0).unwrap();
+    case.write(
+        "bind.script",
+        &format!(
+            "select 1 0\nmap base_color tex\nmap roughness rough\nmap emission tex.G\nset emission 2,1,0.5\n\
+             save-look all.toml\nundo\nundo\nsave-look two.toml\nmap roughness none\nsave-look one.toml\nundo\n\
+             undo\nundo\nsave-look none.toml\nredo\nredo\nredo\nwait-spp 4\npick {} {}\n",
+            ball as u32 % SIZE,
+            ball as u32 / SIZE
+        ),
+    );
+    let output =
+        case.view(&["look.toml", "--script", "bind.script", "--exit-after-spp", "4", "--screenshot", "shot.png"]);
+    assert_success(&output);
+    let bound = |file: &str| -> Vec<(Param, String)> {
+        let look = Look::load(&case.path(file)).unwrap();
+        look.stack_for(1).unwrap().layers[0].maps.iter().map(|(p, m)| (*p, m.clone())).collect()
+    };
+    let pair = |p: Param, m: &str| (p, m.to_string());
+    assert_eq!(
+        bound("all.toml"),
+        [pair(Param::BaseColor, "tex"), pair(Param::Roughness, "rough"), pair(Param::Emission, "tex.G")]
+    );
+    assert_eq!(bound("two.toml"), [pair(Param::BaseColor, "tex"), pair(Param::Roughness, "rough")]);
+    assert_eq!(bound("one.toml"), [pair(Param::BaseColor, "tex")]);
+    assert!(bound("none.toml").is_empty());
+    let original = Look::load(&case.path("look.toml")).unwrap();
+    let none = Look::load(&case.path("none.toml")).unwrap();
+    assert_eq!(none.objects, original.objects, "undone back to the start, everything is as it was");
+    let all = Look::load(&case.path("all.toml")).unwrap();
+    assert_eq!(all.stack_for(1).unwrap().layers[0].params.emission, [2.0, 1.0, 0.5]);
+
+    // Redone to `one`: the screenshot is that look's render, and the inspector shows the maps.
+    let shot = case.screenshot_image(&output, "shot.png");
+    assert_matches_render(&shot, &case.render("one.toml", 4, "one.png"));
+    assert_differs(&shot, &case.render("none.toml", 4, "none.png"), "bound vs unbound");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let pick = stdout.lines().find(|l| l.starts_with("lookdev: pixel")).expect("the pick is reported");
+    let tex_r = gbuffer.maps["tex.R"][ball];
+    assert!(pick.contains(&format!("map.tex.R {tex_r:.4}")), "{pick}");
+    assert!(pick.contains(&format!("map.rough {:.4}", gbuffer.maps["rough"][ball])), "{pick}");
+}
+
+#[test]
+fn bindings_the_gbuffer_cannot_satisfy_stop_the_script_at_their_line() {
+    let Some(case) = Case::new() else { return };
+    write_mapped_gbuffer(&case);
+    for (script, phrase) in [
+        ("select 1 0\nmap roughness tex\n", "bad.script:2: map 'tex' of the g-buffer g.exr is a colour map"),
+        (
+            "select 1 0\n\nmap base_color texx\n",
+            "bad.script:3: map 'texx' (bound to base_color) is not in the g-buffer",
+        ),
+        ("select 1 0\nmap shine tex\n", "bad.script:2: unknown parameter 'shine'"),
+    ] {
+        case.write("bad.script", script);
+        let output = case.view(&["look.toml", "--script", "bad.script"]);
+        assert_eq!(output.status.code(), Some(2), "{script}");
+        let text = stderr(&output);
+        assert!(text.contains(phrase) && !text.contains("panicked"), "{text}");
+        assert_eq!(text.trim().lines().filter(|l| l.contains("error")).count(), 1, "{text}");
+    }
+}
+
 #[test]
 fn rotating_the_light_changes_the_image_and_leaves_the_materials_alone() {
     let Some(case) = Case::new() else { return };

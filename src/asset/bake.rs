@@ -312,7 +312,10 @@ fn gpu_material(
         pad: 0.0,
         base_color_factor: factor,
         sheen_color_factor: extension_color("KHR_materials_sheen", "sheenColorFactor", [0.0; 3]),
-        specular_color_factor: extension_color("KHR_materials_specular", "specularColorFactor", [1.0; 3]),
+        specular_color_factor: {
+            let [r, g, b] = material.specular().map_or([1.0; 3], |s| s.specular_color_factor());
+            [r, g, b, 0.0]
+        },
         slots,
     }
 }

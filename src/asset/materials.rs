@@ -272,11 +272,6 @@ pub fn map(material: &gltf::Material, vertex_colors: bool) -> Mapped {
     let factor = pbr.base_color_factor();
     let base_color = [factor[0], factor[1], factor[2]];
     let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
-    if maps.contains(&MapKind::BaseColor) {
-        notes.push(
-            "base_color is the base colour factor; the look multiplies it by the g-buffer's base colour map".into(),
-        );
-    }
 
     // Specular: the dielectric F0 of the IOR, scaled by KHR_materials_specular.
     let ior = material.ior().unwrap_or(1.5).max(1.0);

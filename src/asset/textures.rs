@@ -1,9 +1,9 @@
 //! The textures a material samples: where each comes from (texture, texcoord set and
 //! KHR_texture_transform), the colour space it is stored in, and the mip chain the bake samples.
 //!
-//! Core textures are read through the `gltf` crate; the extensions' textures (clearcoat, sheen,
-//! specular) from their JSON, which [`super::Asset::load`] checks first, so that every index
-//! here is valid.
+//! Core and specular textures are read through the `gltf` crate; the clearcoat and sheen
+//! textures from their JSON, which [`super::Asset::load`] checks first, so that every index here
+//! is valid.
 
 use gltf::json::Value;
 use image::RgbaImage;
@@ -53,12 +53,12 @@ impl Slot {
         }
     }
 
-    /// The extension holding the slot's textureInfo, for the extensions' slots.
+    /// The extension holding the slot's textureInfo as JSON, for the extensions the `gltf` crate
+    /// does not read itself (it reads KHR_materials_specular).
     fn extension(self) -> Option<&'static str> {
         match self {
             Slot::Clearcoat | Slot::ClearcoatRoughness => Some("KHR_materials_clearcoat"),
             Slot::SheenColor => Some("KHR_materials_sheen"),
-            Slot::Specular | Slot::SpecularColor => Some("KHR_materials_specular"),
             _ => None,
         }
     }
@@ -84,11 +84,12 @@ pub struct TextureRef {
 /// The identity transform.
 const IDENTITY: [[f32; 3]; 2] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
 
-/// KHR_texture_transform's matrix, translation · rotation · scale, as the extension's GLSL writes
-/// it: u' = cos·sx·u − sin·sy·v + ox, v' = sin·sx·u + cos·sy·v + oy.
+/// KHR_texture_transform's matrix, translation · rotation · scale, with the rotation's sign as
+/// the ratified extension and its TextureTransformTest sample give it: u' = cos·sx·u + sin·sy·v
+/// + ox, v' = −sin·sx·u + cos·sy·v + oy.
 pub fn transform_matrix(offset: [f32; 2], rotation: f32, scale: [f32; 2]) -> [[f32; 3]; 2] {
     let (sin, cos) = rotation.sin_cos();
-    [[cos * scale[0], -sin * scale[1], offset[0]], [sin * scale[0], cos * scale[1], offset[1]]]
+    [[cos * scale[0], sin * scale[1], offset[0]], [-sin * scale[0], cos * scale[1], offset[1]]]
 }
 
 fn number(value: &Value, key: &str) -> Option<f32> {
@@ -147,6 +148,10 @@ pub fn material_textures(material: &gltf::Material) -> [Option<TextureRef>; SLOT
         Slot::BaseColor => pbr.base_color_texture().map(|t| TextureRef::from_info(&t)),
         Slot::MetallicRoughness => pbr.metallic_roughness_texture().map(|t| TextureRef::from_info(&t)),
         Slot::Emissive => material.emissive_texture().map(|t| TextureRef::from_info(&t)),
+        Slot::Specular => material.specular().and_then(|s| s.specular_texture()).map(|t| TextureRef::from_info(&t)),
+        Slot::SpecularColor => {
+            material.specular().and_then(|s| s.specular_color_texture()).map(|t| TextureRef::from_info(&t))
+        }
         Slot::Normal => material.normal_texture().map(|t| {
             let reference = TextureRef { texture: t.texture().index(), tex_coord: t.tex_coord(), transform: IDENTITY };
             match t.extension_value("KHR_texture_transform") {
@@ -223,11 +228,11 @@ mod tests {
         assert_eq!(transform_matrix([0.0, 0.0], 0.0, [1.0, 1.0]), IDENTITY);
         let m = transform_matrix([0.5, 0.25], std::f32::consts::FRAC_PI_2, [2.0, 3.0]);
         let apply = |u: f32, v: f32| (m[0][0] * u + m[0][1] * v + m[0][2], m[1][0] * u + m[1][1] * v + m[1][2]);
-        // Scale (1, 0) to (2, 0), turn it a quarter to (0, 2), then offset.
+        // Scale (1, 0) to (2, 0), turn it a quarter to (0, −2), then offset.
         let (u, v) = apply(1.0, 0.0);
-        assert!((u - 0.5).abs() < 1e-6 && (v - 2.25).abs() < 1e-6, "{u} {v}");
+        assert!((u - 0.5).abs() < 1e-6 && (v - (0.25 - 2.0)).abs() < 1e-6, "{u} {v}");
         let (u, v) = apply(0.0, 1.0);
-        assert!((u - (0.5 - 3.0)).abs() < 1e-6 && (v - 0.25).abs() < 1e-6, "{u} {v}");
+        assert!((u - (0.5 + 3.0)).abs() < 1e-6 && (v - 0.25).abs() < 1e-6, "{u} {v}");
     }
 
     #[test]

@@ -1,11 +1,20 @@
-//! `lookdev lint LOOK.toml`: implausible material values, each with its reason.
+//! `lookdev lint LOOK.toml [--gbuffer G.exr]`: implausible material values, each with its reason.
 //!
-//! Every layer's resolved parameters (its preset with its overrides) are checked. A look that
-//! passes prints nothing and exits 0; findings are printed one per line, `FILE:LINE: object,
-//! layer: finding`, and the exit code is 1. A look that cannot be read is an error (exit 2).
+//! Every layer's resolved parameters (its preset with its overrides) are checked. A parameter
+//! bound to a map holds a factor, not a value, so the rules that read it are left out; with
+//! `--gbuffer`, the masks and maps the look names must be in the g-buffer (as for a render), and
+//! the bound layers are checked at every covered pixel where they show (blend weight at least
+//! 0.5), with the factor times the map: a finding there gives the share of those pixels. A look
+//! that passes prints nothing and exits 0; findings are printed one per line, `FILE:LINE: object,
+//! layer: finding`, and the exit code is 1. A look or g-buffer that cannot be read is an error
+//! (exit 2).
 
-use crate::material::params::Params;
+use crate::gbuffer::GBuffer;
+use crate::material::look::{Layer, ObjectStack};
+use crate::material::params::{Param, Params};
+use crate::material::stack::{layer_weights, PackedStacks};
 use crate::material::Look;
+use crate::render::scene::covered_object_ids;
 use crate::shading::common::luminance;
 use crate::{Error, Result};
 use clap::Args;
@@ -15,6 +24,29 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct LintArgs {
     pub look: PathBuf,
+    /// Check the look's masks and maps against this g-buffer, and the bound layers at its pixels.
+    #[arg(long, value_name = "FILE.exr")]
+    pub gbuffer: Option<PathBuf>,
+}
+
+/// The rules, each reading some parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Rule {
+    MetallicInBetween,
+    DielectricAlbedo,
+    MetalReflectance,
+    SpecularAboveOne,
+}
+
+impl Rule {
+    /// The parameters the rule reads: binding any of them to a map leaves it to the g-buffer.
+    fn reads(self) -> &'static [Param] {
+        match self {
+            Rule::MetallicInBetween => &[Param::Metallic],
+            Rule::DielectricAlbedo | Rule::MetalReflectance => &[Param::Metallic, Param::BaseColor],
+            Rule::SpecularAboveOne => &[Param::Specular],
+        }
+    }
 }
 
 /// Plausible ranges, from measured materials: charcoal reflects about 4% and fresh snow about
@@ -25,48 +57,73 @@ pub const DIELECTRIC_ALBEDO: (f32, f32) = (0.02, 0.9);
 pub const METAL_F0_MIN: f32 = 0.45;
 pub const SPECULAR_MAX: f32 = 1.0;
 
-/// The findings for one set of parameters.
-pub fn check(params: &Params) -> Vec<String> {
+/// The findings for one set of parameters, with the rule behind each.
+pub fn findings(params: &Params) -> Vec<(Rule, String)> {
     let mut findings = Vec::new();
     let m = params.metallic;
     let lum = luminance(Vec3::from(params.base_color));
     if m > 0.0 && m < 1.0 {
-        findings.push(format!(
+        findings.push((Rule::MetallicInBetween, format!(
             "metallic = {m} is in between: a surface is a metal or it is not; blend a metal layer in through a mask instead"
-        ));
+        )));
     }
     if m < 0.5 && !(DIELECTRIC_ALBEDO.0..=DIELECTRIC_ALBEDO.1).contains(&lum) {
-        findings.push(format!(
+        findings.push((Rule::DielectricAlbedo, format!(
             "base_color luminance {lum:.3} is outside [{}, {}] for a dielectric: charcoal reflects about 0.04 and fresh snow about 0.9",
             DIELECTRIC_ALBEDO.0, DIELECTRIC_ALBEDO.1
-        ));
+        )));
     }
     if m >= 0.5 && lum < METAL_F0_MIN {
-        findings.push(format!(
+        findings.push((Rule::MetalReflectance, format!(
             "metal F0 (base_color) luminance {lum:.3} is below {METAL_F0_MIN}: darker than any common metal at normal incidence"
-        ));
+        )));
     }
     if params.specular > SPECULAR_MAX {
         let f0 = 0.08 * params.specular;
         let ior = (1.0 + f0.sqrt()) / (1.0 - f0.sqrt());
-        findings.push(format!(
-            "specular = {} is above 1: F0 {f0:.3}, an IOR of {ior:.2}, more than almost any dielectric but gems",
-            params.specular
+        findings.push((
+            Rule::SpecularAboveOne,
+            format!(
+                "specular = {} is above 1: F0 {f0:.3}, an IOR of {ior:.2}, more than almost any dielectric but gems",
+                params.specular
+            ),
         ));
     }
     findings
 }
 
+/// A bound layer's findings at the g-buffer's pixels: each rule that fails at more than this
+/// share of the pixels where the layer shows is reported (filtered texels in between are normal).
+pub const PIXEL_SHARE: f32 = 0.01;
+
 pub fn run(args: LintArgs) -> Result<()> {
     let look = Look::load(&args.look)?;
+    let gbuffer = match &args.gbuffer {
+        Some(path) => {
+            let gbuffer = GBuffer::read(path)?;
+            // The masks and maps must be there, as for a render.
+            PackedStacks::pack(&look, covered_object_ids(&gbuffer), &gbuffer, path)?;
+            Some(gbuffer)
+        }
+        None => None,
+    };
     let mut count = 0;
     for object in &look.objects {
         let who = object.id.map(|id| format!("object {id}")).unwrap_or_else(|| "default stack".into());
         for (i, layer) in object.layers.iter().enumerate() {
             let name = layer.preset.as_deref().map(|p| format!(" ({p})")).unwrap_or_default();
-            for finding in check(&layer.params) {
+            let mut report = |finding: String| {
                 println!("{}:{}: {who}, layer {i}{name}: {finding}", args.look.display(), layer.line);
                 count += 1;
+            };
+            let unbound = |rule: Rule| !rule.reads().iter().any(|p| layer.maps.contains_key(p));
+            for (_, finding) in findings(&layer.params).into_iter().filter(|(rule, _)| unbound(*rule)) {
+                report(finding);
+            }
+            if let Some(gbuffer) = gbuffer.as_ref().filter(|_| !layer.maps.is_empty() && layer.enabled) {
+                for finding in pixel_findings(&look, object, i, gbuffer, &unbound) {
+                    report(finding);
+                }
             }
         }
     }
@@ -76,9 +133,66 @@ pub fn run(args: LintArgs) -> Result<()> {
     Ok(())
 }
 
+/// The findings of the rules that read a bound parameter, for layer `index` of `stack`, over the
+/// covered pixels of the objects that stack shades where the layer's blend weight is at least
+/// 0.5: the layer's own material there (its values times its maps), each rule reported with the
+/// share of those pixels it fails at and the first failing value.
+fn pixel_findings(
+    look: &Look,
+    stack: &ObjectStack,
+    index: usize,
+    gbuffer: &GBuffer,
+    unbound: &dyn Fn(Rule) -> bool,
+) -> Vec<String> {
+    // A look of this one layer alone, filling, resolves its own material at each pixel.
+    let lone = Look {
+        objects: vec![ObjectStack { id: None, layers: vec![Layer { mask: None, ..stack.layers[index].clone() }] }],
+        ..look.clone()
+    };
+    let Ok(packed) = PackedStacks::pack(&lone, covered_object_ids(gbuffer), gbuffer, std::path::Path::new("")) else {
+        return Vec::new();
+    };
+    let mut shown = 0usize;
+    let mut failed: Vec<(Rule, usize, String)> = Vec::new();
+    for p in 0..gbuffer.pixel_count() {
+        let id = gbuffer.object_id[p];
+        if gbuffer.coverage[p] <= 0.0 || !look.stack_for(id).is_some_and(|s| std::ptr::eq(s, stack)) {
+            continue;
+        }
+        let mask_value = |name: &str| gbuffer.masks.get(name).map_or(0.0, |m| m[p]);
+        let weight = layer_weights(stack, mask_value)[index].map_or(0.0, |w| w.blend);
+        if weight < 0.5 {
+            continue;
+        }
+        shown += 1;
+        for (rule, text) in findings(&packed.resolve_gbuffer_pixel(gbuffer, p)) {
+            if unbound(rule) {
+                continue;
+            }
+            match failed.iter_mut().find(|(r, _, _)| *r == rule) {
+                Some(entry) => entry.1 += 1,
+                None => failed.push((rule, 1, text)),
+            }
+        }
+    }
+    failed.sort();
+    failed
+        .into_iter()
+        .filter(|&(_, n, _)| n as f32 > PIXEL_SHARE * shown as f32)
+        .map(|(_, n, text)| {
+            let share = 100.0 * n as f32 / shown as f32;
+            format!("with its maps, {share:.1}% of the {shown} pixels where it shows fail; the first: {text}")
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn check(params: &Params) -> Vec<String> {
+        findings(params).into_iter().map(|(_, text)| text).collect()
+    }
 
     #[test]
     fn each_rule_fires_and_plausible_materials_pass() {

@@ -207,6 +207,16 @@ fn layer_params(look_path: &Path, object: &str, layer: usize) -> Result<(Params,
     })?;
     let defaults = Params::default();
     let set = Param::ALL.into_iter().filter(|p| chosen.params.get(*p) != defaults.get(*p)).collect();
+    // A preset holds constants: a bound parameter keeps its factor, and the map is left behind.
+    if !chosen.maps.is_empty() {
+        let bound: Vec<String> = chosen.maps.iter().map(|(param, map)| format!("{param} (map '{map}')")).collect();
+        crate::warn(format!(
+            "{}:{}: the preset keeps constants only; dropped the maps of {}, whose values are their factors",
+            look_path.display(),
+            chosen.line,
+            bound.join(", ")
+        ));
+    }
     Ok((chosen.params, set))
 }
 

@@ -103,6 +103,24 @@ fn bound_channels(
     }
 }
 
+/// Whether a parameter can be bound to `map` of this g-buffer: the error says why not, naming
+/// the file and the maps it has.
+pub fn check_binding(
+    param: Param,
+    map: &str,
+    gbuffer: &GBuffer,
+    gbuffer_name: &Path,
+) -> std::result::Result<(), String> {
+    bound_channels(param, map, gbuffer, gbuffer_name).map(|_| ())
+}
+
+/// The maps of this g-buffer a parameter can be bound to, as a binding names them: for a colour,
+/// the colour maps, then every channel (as a grey); for a number, every channel.
+pub fn bindable_maps(param: Param, gbuffer: &GBuffer) -> Vec<String> {
+    let colours = gbuffer.maps().into_iter().filter(|m| m.color && param.is_color()).map(|m| m.name);
+    colours.chain(gbuffer.maps.keys().cloned()).collect()
+}
+
 /// Every map binding of the look, on any layer of any stack (disabled ones too, as for masks),
 /// must name a map of the g-buffer that fits its parameter.
 fn check_maps(look: &Look, gbuffer: &GBuffer, gbuffer_name: &Path) -> Result<()> {

@@ -21,6 +21,12 @@ pub enum Action {
     AddPresetLayer(String),
     /// Sets the mask of the selected layer, after checking that the g-buffer has it.
     SetMask(Option<String>),
+    /// Binds a parameter of the selected layer to a g-buffer map (`None`: unbinds it), after
+    /// checking that the g-buffer has the map and that it fits the parameter.
+    SetMap {
+        param: crate::material::Param,
+        map: Option<String>,
+    },
     /// A click on image pixel (x, y): select the object there and inspect the pixel.
     Pick {
         x: u32,

@@ -411,6 +411,20 @@ impl Running {
                 let (object, layer) = selected_layer(document)?;
                 document.apply(Edit::SetMask { object, layer, mask }).map_err(Error::input)?;
             }
+            Action::SetMap { param, map } => {
+                if let Some(name) = &map {
+                    crate::material::stack::check_binding(
+                        param,
+                        name,
+                        &self.session.gbuffer,
+                        &self.session.gbuffer_name,
+                    )
+                    .map_err(Error::input)?;
+                }
+                let document = &mut self.session.document;
+                let (object, layer) = selected_layer(document)?;
+                document.apply(Edit::SetMap { object, layer, param, map }).map_err(Error::input)?;
+            }
             Action::Pick { x, y } => {
                 let pixel = self.session.inspect(x, y)?;
                 if pixel.coverage > 0.0 {
@@ -438,8 +452,13 @@ impl Running {
             Action::SaveLayerAsPreset { name, description, tags, force } => {
                 let (object, layer) = selected_layer(document)?;
                 let written = document.save_layer_as_preset(object, layer, &name, &description, &tags, force)?;
+                let bound = document.stack(object).map_or(0, |s| s.layers[layer].maps.len());
                 self.interface.refresh_library();
-                return Ok(Some(format!("saved preset {name} to {}", written.display())));
+                let dropped = match bound {
+                    0 => String::new(),
+                    n => format!(" (constants only: its {n} map binding(s) stay in the look)"),
+                };
+                return Ok(Some(format!("saved preset {name} to {}{dropped}", written.display())));
             }
             Action::SaveImage(path) => {
                 let spp = self.session.save_image(&path)?;

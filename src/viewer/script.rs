@@ -58,7 +58,7 @@ impl LayerChange {
 }
 
 /// The commands, for the error that names an unknown one.
-const COMMANDS: &str = "select, set, reset, add, remove, duplicate, move, show, hide, mask, invert, opacity, \
+const COMMANDS: &str = "select, set, reset, map, add, remove, duplicate, move, show, hide, mask, invert, opacity, \
     rotate, intensity, background, env, exposure, tonemap, spp, seed, undo, redo, pick, wait-spp, save-look, \
     save-preset, save-image, screenshot, open-look, quit, answer, compare, divider";
 
@@ -176,6 +176,11 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
         "move" => {
             arity(1)?;
             layer(LayerChange::Move(number(args[0], "layer")?))
+        }
+        "map" => {
+            arity(2)?;
+            let map = if args[1] == "none" { None } else { Some(args[1].to_string()) };
+            Ok(Step::Do(Action::SetMap { param: parameter(args[0])?, map }))
         }
         "mask" => {
             arity(1)?;

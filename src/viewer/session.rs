@@ -43,6 +43,8 @@ pub struct Inspection {
     pub coverage: f32,
     /// Every g-buffer mask's value here, by name.
     pub masks: Vec<(String, f32)>,
+    /// Every g-buffer map channel's value here, by name (`baseColor.R`, `rough`).
+    pub maps: Vec<(String, f32)>,
     /// The stack that shades the pixel, and each of its layers' weight here (`None`: hidden).
     pub stack: Option<ObjectRef>,
     pub layers: Vec<(String, Option<LayerWeight>)>,
@@ -59,6 +61,9 @@ impl std::fmt::Display for Inspection {
         write!(f, "pixel {},{}: object {}, coverage {:.4}", self.x, self.y, self.object_id, self.coverage)?;
         for (name, value) in &self.masks {
             write!(f, ", mask.{name} {value:.4}")?;
+        }
+        for (name, value) in &self.maps {
+            write!(f, ", map.{name} {value:.4}")?;
         }
         if let Some(stack) = self.stack {
             write!(f, "; {stack}:")?;
@@ -470,6 +475,8 @@ impl Session {
         let coverage = self.gbuffer.coverage[index];
         let masks: Vec<(String, f32)> =
             self.gbuffer.masks.iter().map(|(name, values)| (name.clone(), values[index])).collect();
+        let maps: Vec<(String, f32)> =
+            self.gbuffer.maps.iter().map(|(name, values)| (name.clone(), values[index])).collect();
         let mask_value = |name: &str| masks.iter().find(|(n, _)| n == name).map_or(0.0, |(_, v)| *v);
         let shaded = coverage > 0.0;
         let stack = shaded.then(|| self.stack_of(object_id));
@@ -487,8 +494,19 @@ impl Session {
         } else {
             [0.0; 4]
         };
-        let inspection =
-            Inspection { x, y, object_id, coverage, masks, stack, layers, params, radiance, samples: self.samples() };
+        let inspection = Inspection {
+            x,
+            y,
+            object_id,
+            coverage,
+            masks,
+            maps,
+            stack,
+            layers,
+            params,
+            radiance,
+            samples: self.samples(),
+        };
         self.inspection = Some(inspection.clone());
         Ok(inspection)
     }

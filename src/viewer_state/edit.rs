@@ -93,6 +93,15 @@ pub enum Edit {
         layer: usize,
         enabled: bool,
     },
+    /// Binds a parameter of a layer to a g-buffer map (`name`, or `name.R|G|B` for one
+    /// channel), or unbinds it with `None`; the value stays, as the factor the map multiplies.
+    /// A name must not be empty. Whether the g-buffer has the map is the viewer's to check.
+    SetMap {
+        object: ObjectRef,
+        layer: usize,
+        param: Param,
+        map: Option<String>,
+    },
     /// The g-buffer mask that weights a layer; `None` is 1 everywhere. A name must not be empty.
     SetMask {
         object: ObjectRef,
@@ -236,6 +245,17 @@ impl State {
             })?,
             Edit::SetEnabled { object, layer, enabled } => next.edit_stack(object, |stack| {
                 layer_mut(stack, object, layer)?.enabled = enabled;
+                Ok(())
+            })?,
+            Edit::SetMap { object, layer, param, map } => next.edit_stack(object, |stack| {
+                let layer = layer_mut(stack, object, layer)?;
+                match map {
+                    Some(map) if map.trim().is_empty() || map.trim() != map => {
+                        return Err(format!("{param}: a map's name must not be empty or have spaces around it"))
+                    }
+                    Some(map) => layer.maps.insert(param, map),
+                    None => layer.maps.remove(&param),
+                };
                 Ok(())
             })?,
             Edit::SetMask { object, layer, mask } => next.edit_stack(object, |stack| {

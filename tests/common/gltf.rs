@@ -10,6 +10,8 @@ pub struct Mesh {
     pub positions: Vec<[f32; 3]>,
     pub normals: Vec<[f32; 3]>,
     pub uvs: Vec<[f32; 2]>,
+    /// TEXCOORD_1, where the primitive has a second set.
+    pub uvs1: Option<Vec<[f32; 2]>>,
     pub tangents: Option<Vec<[f32; 4]>>,
     pub colors: Option<Vec<[f32; 4]>>,
     pub indices: Vec<u32>,
@@ -180,6 +182,9 @@ impl Gltf {
         });
         if let Some(tangents) = &mesh.tangents {
             attributes["TANGENT"] = json!(self.floats(tangents, "VEC4", false));
+        }
+        if let Some(uvs) = &mesh.uvs1 {
+            attributes["TEXCOORD_1"] = json!(self.floats(uvs, "VEC2", false));
         }
         if let Some(colors) = &mesh.colors {
             attributes["COLOR_0"] = json!(self.floats(colors, "VEC4", false));

@@ -26,6 +26,11 @@ pub fn show(ui: &mut egui::Ui, session: &Session) {
             ui.label(format!("{value:.3}"));
             ui.end_row();
         }
+        for (name, value) in &pixel.maps {
+            ui.label(format!("map.{name}"));
+            ui.label(format!("{value:.3}"));
+            ui.end_row();
+        }
         ui.label("Radiance");
         let [r, g, b, a] = pixel.radiance;
         ui.label(format!("{r:.4}, {g:.4}, {b:.4}")).on_hover_text(format!(

@@ -5,6 +5,7 @@ use super::super::action::Action;
 use super::super::session::{layer_label, Session};
 use crate::material::look::{Layer, ObjectStack};
 use crate::material::params::{Param, Value};
+use crate::material::stack::bindable_maps;
 use crate::viewer_state::{Edit, ObjectRef, Selection};
 use egui::{Color32, RichText};
 
@@ -119,7 +120,7 @@ fn layer_list(
     add
 }
 
-/// "gold · stripes (inverted) · 60%".
+/// "gold · stripes (inverted) · 60% · 2 maps".
 fn layer_summary(layer: &Layer, index: usize) -> String {
     let mut text = layer_label(layer);
     if index > 0 {
@@ -129,6 +130,11 @@ fn layer_summary(layer: &Layer, index: usize) -> String {
         if layer.opacity < 1.0 {
             text += &format!(" · {:.0}%", layer.opacity * 100.0);
         }
+    }
+    match layer.maps.len() {
+        0 => {}
+        1 => text += " · 1 map",
+        n => text += &format!(" · {n} maps"),
     }
     text
 }
@@ -192,6 +198,14 @@ fn parameters(
         override_dot(ui, false);
         ui.label(RichText::new("the preset's value").weak());
     });
+    // Bindings show only where there is something to bind to (or something bound).
+    let with_maps = !session.gbuffer.maps.is_empty() || !layer.maps.is_empty();
+    if with_maps {
+        ui.label(
+            RichText::new("Click a parameter to bind it to a map: bound (blue), it is its value times the map's.")
+                .weak(),
+        );
+    }
     egui::Grid::new("parameters").num_columns(4).spacing([6.0, 4.0]).show(ui, |ui| {
         for param in Param::ALL {
             let overridden = document.is_overridden(object, index, param);
@@ -201,19 +215,29 @@ fn parameters(
             } else {
                 "The preset's value".to_string()
             });
-            ui.label(param.name());
+            let bound = layer.maps.get(&param);
+            if with_maps {
+                map_choice(ui, session, param, bound, actions);
+            } else {
+                ui.label(param.name());
+            }
             let value = layer.params.get(param);
             let mut changed = None;
             match value {
                 Value::Color(mut rgb) => {
                     ui.horizontal(|ui| {
-                        // egui's picker works in sRGB and hands back linear values, as stored.
-                        if egui::widgets::color_picker::color_edit_button_rgb(ui, &mut rgb).changed() {
+                        // egui's picker works in sRGB and hands back linear values, as stored; it
+                        // holds [0, 1], so emission above 1 is typed into the fields.
+                        if rgb.iter().all(|&c| c <= 1.0)
+                            && egui::widgets::color_picker::color_edit_button_rgb(ui, &mut rgb).changed()
+                        {
                             changed = Some(Value::Color(rgb));
                         }
                         for channel in 0..3 {
-                            let drag =
-                                egui::DragValue::new(&mut rgb[channel]).range(0.0..=1.0).speed(0.002).max_decimals(4);
+                            let drag = egui::DragValue::new(&mut rgb[channel])
+                                .range(0.0..=param.max())
+                                .speed(0.002)
+                                .max_decimals(4);
                             if ui.add(drag).on_hover_text("Linear value").changed() {
                                 changed = Some(Value::Color(rgb));
                             }
@@ -246,6 +270,35 @@ fn parameters(
             }
             ui.end_row();
         }
+    });
+}
+
+/// The parameter's name as a menu of the g-buffer's maps it can be bound to: blue when bound,
+/// with the map named on hover.
+fn map_choice(ui: &mut egui::Ui, session: &Session, param: Param, bound: Option<&String>, actions: &mut Vec<Action>) {
+    let mut title = RichText::new(param.name());
+    if bound.is_some() {
+        title = title.color(ui.visuals().hyperlink_color);
+    }
+    let menu = ui.menu_button(title, |ui| {
+        if ui.selectable_label(bound.is_none(), "no map").clicked() {
+            if bound.is_some() {
+                actions.push(Action::SetMap { param, map: None });
+            }
+            ui.close();
+        }
+        for map in bindable_maps(param, &session.gbuffer) {
+            if ui.selectable_label(bound == Some(&map), format!("map.{map}")).clicked() {
+                if bound != Some(&map) {
+                    actions.push(Action::SetMap { param, map: Some(map.clone()) });
+                }
+                ui.close();
+            }
+        }
+    });
+    menu.response.on_hover_text(match bound {
+        Some(map) => format!("Bound: the value times map.{map} at each pixel. Click to change."),
+        None => "Click to bind to a g-buffer map".to_string(),
     });
 }
 
