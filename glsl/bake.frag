@@ -13,11 +13,12 @@ layout(location = 0) in vec3 world_position;
 layout(location = 1) in vec3 world_normal;
 layout(location = 2) in vec4 world_tangent;
 layout(location = 3) in vec4 color;
+layout(location = SLOT_MASK) flat in uint slot_mask;
 layout(location = SLOT_TEXCOORDS) in vec2 slot_uv[SLOTS];
 
-// A slot's texel; the stand-in where the slot is empty. Sampled before any fragment is
-// discarded, so that every lane of a quad has its derivatives.
-#define SAMPLE(slot) texture(textures[slot], slot_uv[slot])
+// A slot's texel, or white where the slot is empty. Sampled before any fragment is discarded, so
+// that every lane of a quad has its derivatives; the branch is the same for the whole draw.
+#define SAMPLE(slot) ((slot_mask & (1u << slot)) != 0u ? texture(textures[slot], slot_uv[slot]) : vec4(1.0))
 
 layout(location = 0) out vec4 out_normal;       // xyz; w = 1 marks a covered sample
 layout(location = 1) out vec4 out_tangent;      // xyz; w = bitangent sign
@@ -45,7 +46,7 @@ void main() {
         b = -b;
     }
     vec3 shading = n;
-    if (MATERIAL.slots[SLOT_NORMAL].present != 0u && dot(t, t) > 0.0) {
+    if ((slot_mask & (1u << SLOT_NORMAL)) != 0u && dot(t, t) > 0.0) {
         vec3 bump = normal_texel * 2.0 - 1.0;
         bump.xy *= MATERIAL.normal_scale;
         shading = normalize(bump.x * t + bump.y * b + bump.z * n);

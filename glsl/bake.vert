@@ -18,6 +18,7 @@ layout(location = 0) out vec3 world_position;
 layout(location = 1) out vec3 world_normal;
 layout(location = 2) out vec4 world_tangent;
 layout(location = 3) out vec4 out_color;
+layout(location = SLOT_MASK) flat out uint slot_mask;
 layout(location = SLOT_TEXCOORDS) out vec2 slot_uv[SLOTS];
 
 void main() {
@@ -25,8 +26,10 @@ void main() {
     world_normal = normal;
     world_tangent = tangent;
     out_color = color;
+    slot_mask = 0u;
     for (uint slot = 0u; slot < SLOTS; slot++) {
         slot_uv[slot] = slot_texcoord(slot, uv0, uv1);
+        slot_mask |= MATERIAL.slots[slot].present != 0u ? 1u << slot : 0u;
     }
     gl_Position = draw.view_projection * vec4(position, 1.0);
 }

@@ -18,8 +18,10 @@ const uint SLOTS = 9u;
 // decoded by the sampler. Only the fragment stage samples them.
 layout(set = 0, binding = 0) uniform sampler2D textures[SLOTS];
 
-// The first varying location of the slots' texcoords, one location each.
-#define SLOT_TEXCOORDS 4
+// The varying locations of the slots' texcoords (one each, from SLOT_TEXCOORDS on) and of the
+// bits of the slots that hold a texture (SLOT_MASK, flat).
+#define SLOT_MASK 4
+#define SLOT_TEXCOORDS 5
 
 // Where a slot samples: texcoord = (dot(u.xyz, (uv, 1)), dot(v.xyz, (uv, 1))), KHR_texture_transform.
 struct TextureSlot {

@@ -22,6 +22,7 @@ use crate::gpu::{shaders, Buffer, Context, Image};
 use crate::{Error, Result};
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
+use half::f16;
 use std::collections::{BTreeMap, HashMap};
 
 /// What a bake makes.
@@ -89,8 +90,9 @@ const GEOMETRY_TARGETS: [vk::Format; 5] = [
     vk::Format::R32G32B32A32_SFLOAT, // COLOR_0
 ];
 
-/// The maps pass's render targets (bake_maps.frag), which [`MAP_CHANNELS`] lays out.
-const MAP_TARGETS: [vk::Format; 4] = [vk::Format::R32G32B32A32_SFLOAT; 4];
+/// The maps pass's render targets (bake_maps.frag), which [`MAP_CHANNELS`] lays out. Half floats
+/// hold 8-bit texels and material numbers exactly enough, at half the bandwidth.
+const MAP_TARGETS: [vk::Format; 4] = [vk::Format::R16G16B16A16_SFLOAT; 4];
 
 /// The steps of a bake, for progress reports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -225,7 +227,7 @@ struct Samples<'a> {
     ids: &'a [[u32; 2]],
     color: &'a [[f32; 4]],
     /// The maps pass's targets, when it ran.
-    maps: Vec<&'a [[f32; 4]]>,
+    maps: Vec<&'a [[f16; 4]]>,
 }
 
 /// The sampler a glTF texture asks for: its filters and wrap modes, with mip mapping unless its
@@ -544,7 +546,7 @@ impl Rasterizer {
             view: bytemuck::cast_slice(next(16)),
             ids: bytemuck::cast_slice(next(8)),
             color: bytemuck::cast_slice(next(16)),
-            maps: (GEOMETRY_TARGETS.len()..self.targets.len()).map(|_| bytemuck::cast_slice(next(16))).collect(),
+            maps: (GEOMETRY_TARGETS.len()..self.targets.len()).map(|_| bytemuck::cast_slice(next(8))).collect(),
         })
     }
 }
@@ -628,7 +630,7 @@ impl Accumulator {
         // The maps pass's samples, each counted for the material it names (its alpha).
         let Some(named) = s.maps.first() else { return };
         for p in 0..self.hits.len() {
-            let material = named[p][3] as usize;
+            let material = named[p][3].to_f32() as usize;
             let Some(&kinds) = material.checked_sub(1).and_then(|slot| self.material_kinds.get(slot)) else {
                 continue;
             };
@@ -638,7 +640,7 @@ impl Accumulator {
             for (channel, sums) in &mut self.map_sums {
                 let c = &MAP_CHANNELS[*channel];
                 if kinds & c.kind.bit() != 0 {
-                    sums[p] += s.maps[c.target][p][c.component];
+                    sums[p] += s.maps[c.target][p][c.component].to_f32();
                 }
             }
         }
