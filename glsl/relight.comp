@@ -1,7 +1,7 @@
 #version 460
 // One progressive pass of image-based relighting over a band of rows: for each covered pixel and
 // each sample index, one environment sample and one BRDF sample, combined with the power heuristic
-// (README: Sampling). The running float32 sum of the estimates is accumulated in sample order, so
+// (docs/shading.md: Sampling). The running float32 sum of the estimates is accumulated in sample order, so
 // any split into passes and bands gives the same bits. Coverage and the background are composited
 // by finalize.comp, so background pixels cost nothing after the first pass of an accumulation.
 // Every pixel of a band has the same number of samples so far; keeping that number (and so the

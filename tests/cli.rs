@@ -150,6 +150,11 @@ fn bad_inputs_get_one_clear_line_and_exit_code_2() {
     let look = ws
         .file("mask.toml", "[[object]]\n[[object.layer]]\n[[object.layer]]\npreset = \"gold\"\nmask = \"scratches\"\n");
     assert_bad_input(&render(&["--gbuffer", &g, "--look", &look]), &["mask.toml:3", "scratches", "g.exr"]);
+    // A map the g-buffer lacks (it has none), and a bad binding.
+    let look = ws.file("map.toml", "[[object]]\n[[object.layer]]\n[object.layer.map]\nbase_color = \"albedo\"\n");
+    assert_bad_input(&render(&["--gbuffer", &g, "--look", &look]), &["map.toml:2", "map 'albedo'", "g.exr", "no maps"]);
+    let look = ws.file("binding.toml", "[[object]]\n[[object.layer]]\n[object.layer.map]\nrougness = \"r\"\n");
+    assert_bad_input(&render(&["--look", &look]), &["binding.toml:4", "rougness", "[object.layer.map]"]);
     let look = ws.file("key.toml", "[render]\nsppp = 4\n");
     assert_bad_input(&render(&["--look", &look]), &["key.toml:2", "sppp"]);
     let look = ws.file("param.toml", "[[object]]\n[[object.layer]]\n[object.layer.set]\nrougness = 0.2\n");

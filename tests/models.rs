@@ -1,4 +1,4 @@
-//! The BRDF lab's model variants (README: BRDF models): every distribution is normalised, every
+//! The BRDF lab's model variants (docs/shading.md: BRDF models): every distribution is normalised, every
 //! shadowing term passes the weak white furnace, every diffuse model reflects what numerical
 //! integration says (closed forms where they exist), conductor Fresnel meets its normal-incidence
 //! formula, energy compensation keeps a white rough metal at 1, the renderer's furnace agrees
@@ -129,7 +129,7 @@ fn every_shadowing_term_passes_the_weak_white_furnace() {
         }
     }
     // GTR with γ ≠ 2 shares GGX's Λ (as the 2012 notes pair GTR with a GGX G): the identity holds
-    // only at γ = 2. Measure how far it is off, for the README.
+    // only at γ = 2. Measure how far it is off, for docs/shading.md.
     for gamma in [1.5f32, 3.0] {
         let m = model(&format!("specular_d=gtr gtr_gamma={gamma}"));
         let s = lobes(&material(0.5, 0.0), &m);

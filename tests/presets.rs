@@ -1,6 +1,6 @@
 //! The built-in preset library: every file parses and names itself, metals carry the F0 of
 //! the complex IORs their descriptions cite, dielectric albedos are plausible, and the
-//! library covers the material families the README lists.
+//! library covers the material families docs/formats.md lists.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};

@@ -1,5 +1,5 @@
-// The Disney 2012 principled BRDF, BRDF Explorer revision (README: Shading model), and the BRDF
-// lab's variants of its diffuse, D, G and F terms (README: BRDF models), chosen by the
+// The Disney 2012 principled BRDF, BRDF Explorer revision (docs/shading.md: Shading model), and the BRDF
+// lab's variants of its diffuse, D, G and F terms (docs/shading.md: BRDF models), chosen by the
 // specialization constants of model.glsl. With the default constants every function computes
 // exactly what the Disney model computes.
 //
@@ -238,7 +238,7 @@ float specular_d(Lobes s, vec3 h) {
     return gtr2_aniso(h, s.ax, s.ay);
 }
 
-// Smith G for anisotropic GGX with 1/(4·N·W) folded in: g(W) of the README's shading model.
+// Smith G for anisotropic GGX with 1/(4·N·W) folded in: g(W) of the shading model in docs/shading.md.
 float smith_g_aniso(vec3 w, float ax, float ay) {
     float x = w.x * ax;
     float y = w.y * ay;

@@ -1,4 +1,4 @@
-// The environment: lat-long mapping, radiance lookups and importance sampling (README: Environments, Sampling).
+// The environment: lat-long mapping, radiance lookups and importance sampling (docs/formats.md: Environments, Sampling).
 //
 // Directions here are in environment space: the world direction rotated by R_y(−rotation).
 // u = 0.5 + atan2(d.x, −d.z)/2π (wrapped into [0, 1)), v = acos(d.y)/π, row 0 the zenith.

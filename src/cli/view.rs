@@ -36,7 +36,7 @@ pub struct ViewArgs {
     /// the target spp.
     #[arg(long, value_name = "N")]
     pub exit_after_spp: Option<u32>,
-    /// Run interface actions from a file, one per line (see the README).
+    /// Run interface actions from a file, one per line (see docs/commands.md).
     #[arg(long, value_name = "FILE")]
     pub script: Option<PathBuf>,
     /// Open with an A/B split: B is the look under its model with KEY=VALUE changed (the keys of

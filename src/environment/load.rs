@@ -1,4 +1,4 @@
-//! Reading `.exr` and `.hdr` environments, with the checks of the README's formats.
+//! Reading `.exr` and `.hdr` environments, with the checks of docs/formats.md.
 
 use super::Environment;
 use crate::{Error, Result};

@@ -1,4 +1,4 @@
-//! Looks: what to render. A look file (README: Formats) sets the environment, the render
+//! Looks: what to render. A look file (docs/formats.md: Formats) sets the environment, the render
 //! settings, and one layer stack per object:
 //!
 //! ```toml
@@ -8,7 +8,7 @@
 //! intensity = 1.0        # finite, >= 0
 //! background = true
 //!
-//! [model]                # optional; the BRDF model (README: BRDF models); --model overrides
+//! [model]                # optional; the BRDF model (docs/shading.md: BRDF models); --model overrides
 //! diffuse = "burley2012" # and specular_d, specular_g, fresnel, gtr_gamma, energy_compensation
 //!
 //! [render]               # optional; command-line flags override
@@ -188,7 +188,7 @@ impl Look {
     }
 
     /// The look used for a user g-buffer rendered without a look: every object in the default
-    /// material (README: Presets defaults: grey 0.8 dielectric, roughness 0.5), default settings.
+    /// material (docs/formats.md: Presets defaults: grey 0.8 dielectric, roughness 0.5), default settings.
     pub fn default_material() -> Look {
         let mut look = Look {
             file: None,

@@ -264,7 +264,7 @@ impl Params {
         }
     }
 
-    /// Per-parameter linear blend, `mix(self, other, w)`: the layer-stack rule of the README's formats.
+    /// Per-parameter linear blend, `mix(self, other, w)`: the layer-stack rule of docs/formats.md.
     /// Written as `a·(1−w) + b·w`, as `resolve.comp` does, so that w = 1 gives `other` exactly.
     pub fn mix(&self, other: &Params, w: f32) -> Params {
         let a = self.to_gpu();

@@ -1,4 +1,4 @@
-//! Writing renders: EXR as linear radiance, PNG as display pixels (README: Output).
+//! Writing renders: EXR as linear radiance, PNG as display pixels (docs/formats.md: Output).
 
 use crate::{atomic_file, Error, Result};
 use std::path::Path;

@@ -1,5 +1,5 @@
 //! Mirror of `glsl/include/brdf.glsl`: the Disney 2012 principled BRDF, BRDF Explorer revision,
-//! and the BRDF lab's variants of its terms (README: BRDF models).
+//! and the BRDF lab's variants of its terms (docs/shading.md: BRDF models).
 //!
 //! Every vector is in the shading frame: N = +Z, tangent X = +X, bitangent Y = +Y. The GLSL reads
 //! the model as specialization constants; here [`Lobes`] and [`View`] carry it, and the energy
@@ -289,7 +289,7 @@ pub fn specular_d(s: &Lobes, h: Vec3) -> f32 {
     }
 }
 
-/// Smith G for anisotropic GGX with 1/(4·N·W) folded in: g(W) of the README's shading model.
+/// Smith G for anisotropic GGX with 1/(4·N·W) folded in: g(W) of the shading model in docs/shading.md.
 pub fn smith_g_aniso(w: Vec3, ax: f32, ay: f32) -> f32 {
     let x = w.x * ax;
     let y = w.y * ay;
