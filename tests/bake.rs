@@ -5,7 +5,7 @@
 mod common;
 
 use common::cli::{assert_bad_input, assert_success, lookdev, stderr};
-use common::gltf::{camera_looking_down_z, cube, plane, uv_sphere, Gltf, Mesh};
+use common::gltf::{camera_looking_down_z, cube, plane, srgb_to_linear, uv_sphere, Gltf, Mesh};
 use glam::{Mat3, Quat, Vec3};
 use lookdev::asset::bake::{bake, BakeOptions};
 use lookdev::asset::camera::CameraChoice;
@@ -276,15 +276,6 @@ fn a_normal_mapped_plane_bakes_to_the_perturbed_normals_with_given_or_generated_
             let tangent = Vec3::from(g.tangent[y * 64 + x]);
             assert!(tangent.dot(Vec3::X) > 0.9, "the tangent follows +u: {tangent}");
         }
-    }
-}
-
-fn srgb_to_linear(c: u8) -> f32 {
-    let c = c as f32 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
     }
 }
 

@@ -18,7 +18,7 @@
 mod common;
 
 use common::cli::{assert_success, stderr};
-use common::gltf::{plane, Gltf};
+use common::gltf::{plane, srgb_to_linear, Gltf};
 use glam::{Mat3, Vec3};
 use lookdev::asset::bake::jitter_pattern;
 use lookdev::environment::Distribution;
@@ -45,15 +45,6 @@ const EMISSIVE_STRENGTH: f32 = 0.5;
 const BASE_COLOR_TRANSFORM: ([f32; 2], f32, [f32; 2]) = ([0.1, 0.05], 0.3, [0.8, 0.8]);
 /// KHR_texture_transform of the emissive texture, which also moves it to TEXCOORD_1.
 const EMISSIVE_TRANSFORM: ([f32; 2], f32, [f32; 2]) = ([-0.2, 0.1], -0.5, [1.5, 1.25]);
-
-fn srgb_to_linear(c: u8) -> f32 {
-    let c = c as f32 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
 
 /// A hue wheel about the texture's centre (saturation growing outward) under a checker of
 /// 4×4-texel cells, one of which is darkened.

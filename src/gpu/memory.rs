@@ -260,18 +260,7 @@ impl Image {
             );
             offset += bytes.len();
         }
-        ctx.run(|cmd| {
-            unsafe {
-                ctx.device.cmd_copy_buffer_to_image(
-                    cmd,
-                    staging.buffer,
-                    image.image,
-                    vk::ImageLayout::GENERAL,
-                    &regions,
-                )
-            };
-            Ok(())
-        })?;
+        image.copy_from(ctx, &staging, &regions)?;
         Ok(image)
     }
 
@@ -411,15 +400,14 @@ impl Image {
         assert_eq!(data.len() as u64, self.byte_size(), "upload size must match the image");
         let mut staging = Buffer::staging(ctx, self.byte_size())?;
         staging.bytes_mut()[..data.len()].copy_from_slice(data);
+        self.copy_from(ctx, &staging, &[self.copy_region()])
+    }
+
+    /// Copies `regions` of `staging` into the image, in one submission.
+    fn copy_from(&self, ctx: &Context, staging: &Buffer, regions: &[vk::BufferImageCopy]) -> Result<()> {
         ctx.run(|cmd| {
             unsafe {
-                ctx.device.cmd_copy_buffer_to_image(
-                    cmd,
-                    staging.buffer,
-                    self.image,
-                    vk::ImageLayout::GENERAL,
-                    &[self.copy_region()],
-                )
+                ctx.device.cmd_copy_buffer_to_image(cmd, staging.buffer, self.image, vk::ImageLayout::GENERAL, regions)
             };
             Ok(())
         })

@@ -304,3 +304,13 @@ pub fn camera_looking_down_z(gltf: &mut Gltf, name: &str, eye: [f32; 3], yfov_de
     }));
     gltf.node(json!({ "name": name, "camera": camera, "translation": eye }))
 }
+
+/// An sRGB-encoded 8-bit value decoded to linear, by the sRGB definition.
+pub fn srgb_to_linear(c: u8) -> f32 {
+    let c = c as f32 / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
