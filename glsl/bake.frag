@@ -14,11 +14,12 @@ layout(location = 1) in vec3 world_normal;
 layout(location = 2) in vec4 world_tangent;
 layout(location = 3) in vec4 color;
 layout(location = SLOT_MASK) flat in uint slot_mask;
-layout(location = SLOT_TEXCOORDS) in vec2 slot_uv[SLOTS];
+layout(location = SLOT_TEXCOORDS) in vec4 slot_uv[SLOT_PAIRS];
 
 // A slot's texel, or white where the slot is empty. Sampled before any fragment is discarded, so
 // that every lane of a quad has its derivatives; the branch is the same for the whole draw.
-#define SAMPLE(slot) ((slot_mask & (1u << slot)) != 0u ? texture(textures[slot], slot_uv[slot]) : vec4(1.0))
+#define SAMPLE(slot) \
+    ((slot_mask & (1u << slot)) != 0u ? texture(textures[slot], SLOT_UV(slot_uv, slot), draw.lod_bias) : vec4(1.0))
 
 layout(location = 0) out vec4 out_normal;       // xyz; w = 1 marks a covered sample
 layout(location = 1) out vec4 out_tangent;      // xyz; w = bitangent sign

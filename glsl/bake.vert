@@ -19,7 +19,7 @@ layout(location = 1) out vec3 world_normal;
 layout(location = 2) out vec4 world_tangent;
 layout(location = 3) out vec4 out_color;
 layout(location = SLOT_MASK) flat out uint slot_mask;
-layout(location = SLOT_TEXCOORDS) out vec2 slot_uv[SLOTS];
+layout(location = SLOT_TEXCOORDS) out vec4 slot_uv[SLOT_PAIRS];
 
 void main() {
     world_position = position;
@@ -27,8 +27,12 @@ void main() {
     world_tangent = tangent;
     out_color = color;
     slot_mask = 0u;
+    for (uint pair = 0u; pair < SLOT_PAIRS; pair++) {
+        vec2 even = slot_texcoord(2u * pair, uv0, uv1);
+        vec2 odd = 2u * pair + 1u < SLOTS ? slot_texcoord(2u * pair + 1u, uv0, uv1) : vec2(0.0);
+        slot_uv[pair] = vec4(even, odd);
+    }
     for (uint slot = 0u; slot < SLOTS; slot++) {
-        slot_uv[slot] = slot_texcoord(slot, uv0, uv1);
         slot_mask |= MATERIAL.slots[slot].present != 0u ? 1u << slot : 0u;
     }
     gl_Position = draw.view_projection * vec4(position, 1.0);

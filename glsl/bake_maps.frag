@@ -14,16 +14,18 @@ layout(location = 1) in vec3 world_normal;
 layout(location = 2) in vec4 world_tangent;
 layout(location = 3) in vec4 color;
 layout(location = SLOT_MASK) flat in uint slot_mask;
-layout(location = SLOT_TEXCOORDS) in vec2 slot_uv[SLOTS];
+layout(location = SLOT_TEXCOORDS) in vec4 slot_uv[SLOT_PAIRS];
 
 // A slot's texel, or white where the slot is empty. Sampled before any fragment is discarded, so
 // that every lane of a quad has its derivatives; the branch is the same for the whole draw.
-#define SAMPLE(slot) ((slot_mask & (1u << slot)) != 0u ? texture(textures[slot], slot_uv[slot]) : vec4(1.0))
+#define SAMPLE(slot) \
+    ((slot_mask & (1u << slot)) != 0u ? texture(textures[slot], SLOT_UV(slot_uv, slot), draw.lod_bias) : vec4(1.0))
 
-layout(location = 0) out vec4 out_base_color;  // rgb: the base colour texel × COLOR_0; a: material index + 1
+layout(location = 0) out vec4 out_base_color;  // rgb: the base colour texel × COLOR_0
 layout(location = 1) out vec4 out_emission;    // rgb: the emissive texel
 layout(location = 2) out vec4 out_metal_rough_coat;  // metallic, roughness, clearcoat, clearcoat_gloss
 layout(location = 3) out vec4 out_sheen_specular;    // sheen, sheen_tint, specular
+layout(location = 4) out uint out_material;          // the material's index + 1
 
 // Rec.709 luminance, as src/asset/materials.rs weighs colours.
 float luminance(vec3 c) {
@@ -69,7 +71,8 @@ void main() {
     float colour_ratio = luminance(specular_factor) > 0.0
         ? luminance(specular_factor * specular_color_texel) / luminance(specular_factor) : 0.0;
 
-    out_base_color = vec4(base, float(draw.material + 1u));
+    out_base_color = vec4(base, 0.0);
+    out_material = draw.material + 1u;
     out_emission = vec4(emissive.rgb, 0.0);
     out_metal_rough_coat = vec4(metal_rough.b, metal_rough.g, coat, gloss);
     out_sheen_specular = vec4(clamp(sheen_ratio, 0.0, 1.0), tint, clamp(specular_texel * colour_ratio, 0.0, 1.0), 0.0);

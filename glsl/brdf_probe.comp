@@ -12,7 +12,7 @@ layout(local_size_x = 64) in;
 #include "sampling.glsl"
 
 struct Record {
-    vec4 params[4];  // the material, as Params::to_gpu lays it out
+    vec4 params[4];  // the material's BRDF, as Params::brdf_gpu lays it out
     vec4 l;  // shading frame
     vec4 v;
 };

@@ -759,27 +759,131 @@ fn bad_assets_are_refused_with_the_file_and_the_problem_named() {
 #[test]
 fn alpha_masked_materials_cut_out_what_is_below_the_cutoff() {
     let dir = tempfile::tempdir().unwrap();
-    // (factor alpha, texture alpha left and right): what is drawn on the left and the right.
-    for (factor, expect_left, expect_right) in [(1.0, false, true), (0.4, false, false)] {
+    // (factor alpha, cutoff, texture alpha left and right): what is drawn on the left and the
+    // right. A zero cutoff keeps everything, even at alpha 0.
+    for (factor, cutoff, expect_left, expect_right) in
+        [(1.0, 0.5, false, true), (0.4, 0.5, false, false), (0.0, 0.0, true, true)]
+    {
         let mut gltf = Gltf::new();
         let texture = gltf.texture(&image::RgbaImage::from_fn(2, 1, |x, _| {
             image::Rgba([200, 200, 200, if x == 0 { 0 } else { 255 }])
         }));
+        // Behind the leaf, a green board: where the leaf is cut out, the maps show the board.
+        let green = gltf.texture(&image::RgbaImage::from_pixel(1, 1, image::Rgba([0, 255, 0, 255])));
         gltf.json["samplers"] = json!([{ "magFilter": 9728, "minFilter": 9728 }]);
         gltf.json["textures"][texture]["sampler"] = json!(0);
         let material = gltf.material(json!({
             "name": "leaf",
             "alphaMode": "MASK",
-            "alphaCutoff": 0.5,
+            "alphaCutoff": cutoff,
             "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, factor], "baseColorTexture": { "index": texture } }
         }));
-        let mesh = gltf.mesh("plane", &[(&plane(1.0), Some(material))]);
-        gltf.node(json!({ "name": "plane", "mesh": mesh }));
+        let board = gltf
+            .material(json!({ "name": "board", "pbrMetallicRoughness": { "baseColorTexture": { "index": green } } }));
+        let leaf = gltf.mesh("plane", &[(&plane(1.0), Some(material))]);
+        gltf.node(json!({ "name": "plane", "mesh": leaf }));
+        let behind = gltf.mesh("board", &[(&plane(2.0), Some(board))]);
+        gltf.node(json!({ "name": "board", "mesh": behind, "translation": [0.0, 0.0, -0.5] }));
         camera_looking_down_z(&mut gltf, "front", [0.0, 0.0, 1.0 / 20f32.to_radians().tan()], 40.0, 1.0);
         let g = bake_file(&gltf.write_gltf(dir.path(), &format!("leaf-{factor}")), 32, 1);
-        let drawn = |x: usize| g.coverage[16 * 32 + x] == 1.0;
-        assert_eq!((drawn(8), drawn(24)), (expect_left, expect_right), "factor alpha {factor}");
+        let drawn = |x: usize| g.masks["leaf"][16 * 32 + x] == 1.0;
+        assert_eq!((drawn(8), drawn(24)), (expect_left, expect_right), "factor alpha {factor}, cutoff {cutoff}");
+        for x in [8, 24] {
+            let (red, green) = (g.maps["base_color.R"][16 * 32 + x], g.maps["base_color.G"][16 * 32 + x]);
+            let want = if drawn(x) { (srgb_to_linear(200), srgb_to_linear(200)) } else { (0.0, 1.0) };
+            assert!((red - want.0).abs() < 3e-3 && (green - want.1).abs() < 3e-3, "x = {x}: map ({red}, {green})");
+        }
     }
+}
+
+#[test]
+fn textures_smaller_than_their_pixels_are_read_from_mip_levels_in_linear_light() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut gltf = Gltf::new();
+    // A checker of single black and white texels, 256² on a 32² image: eight texels a pixel.
+    // Its mean light is ½, sRGB 188, where averaging the encoded values would give 128's ≈ 0.22.
+    let checker = gltf.texture(&image::RgbaImage::from_fn(256, 256, |x, y| {
+        image::Rgba(if (x + y) % 2 == 0 { [0, 0, 0, 255] } else { [255; 4] })
+    }));
+    let material = gltf
+        .material(json!({ "name": "checker", "pbrMetallicRoughness": { "baseColorTexture": { "index": checker } } }));
+    let mesh = gltf.mesh("plane", &[(&plane(1.0), Some(material))]);
+    gltf.node(json!({ "name": "plane", "mesh": mesh }));
+    camera_looking_down_z(&mut gltf, "front", [0.0, 0.0, 1.0 / 20f32.to_radians().tan()], 40.0, 1.0);
+    let g = bake_file(&gltf.write_gltf(dir.path(), "checker"), 32, 16);
+    let mut worst = 0.0f32;
+    for y in 2..30 {
+        for x in 2..30 {
+            worst = worst.max((g.maps["base_color.R"][y * 32 + x] - 0.5).abs());
+        }
+    }
+    assert!(worst < 0.02, "a pixel's base colour is {worst} from the checker's mean light");
+}
+
+#[test]
+fn where_three_materials_meet_each_takes_its_share_of_the_pixel() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut gltf = Gltf::new();
+    let red = gltf.texture(&image::RgbaImage::from_pixel(1, 1, image::Rgba([255, 0, 0, 255])));
+    let textured =
+        gltf.material(json!({ "name": "a", "pbrMetallicRoughness": { "baseColorTexture": { "index": red } } }));
+    let green =
+        gltf.material(json!({ "name": "b", "pbrMetallicRoughness": { "baseColorFactor": [0.0, 1.0, 0.0, 1.0] } }));
+    let blue =
+        gltf.material(json!({ "name": "c", "pbrMetallicRoughness": { "baseColorFactor": [0.0, 0.0, 1.0, 1.0] } }));
+    // Three strips side by side, their seams at x = ±¼: half-way across pixels 13 and 22 of 36.
+    let strip = |from: f32, to: f32| {
+        let mut mesh = plane(1.0);
+        for p in &mut mesh.positions {
+            p[0] = if p[0] < 0.0 { from } else { to };
+        }
+        mesh
+    };
+    let (a, b, c) = (strip(-1.0, -0.25), strip(-0.25, 0.25), strip(0.25, 1.0));
+    let mesh = gltf.mesh("strips", &[(&a, Some(textured)), (&b, Some(green)), (&c, Some(blue))]);
+    gltf.node(json!({ "name": "strips", "mesh": mesh }));
+    camera_looking_down_z(&mut gltf, "front", [0.0, 0.0, 1.0 / 20f32.to_radians().tan()], 40.0, 1.0);
+    let path = gltf.write_gltf(dir.path(), "strips");
+    let g = bake_file(&path, 36, 16);
+    let import = Import::new(&Asset::load(&path).unwrap()).unwrap();
+    let look = import.look(&dir.path().join("strips.toml"), str::to_string);
+    let stacks = lookdev::material::stack::PackedStacks::pack(
+        &look,
+        lookdev::render::scene::covered_object_ids(&g),
+        &g,
+        Path::new("strips.exr"),
+    )
+    .unwrap();
+    for (x, want) in [
+        (5, [1.0, 0.0, 0.0]),
+        (13, [0.5, 0.5, 0.0]),
+        (18, [0.0, 1.0, 0.0]),
+        (22, [0.0, 0.5, 0.5]),
+        (30, [0.0, 0.0, 1.0]),
+    ] {
+        let base = stacks.resolve_gbuffer_pixel(&g, 18 * 36 + x).base_color;
+        assert!(base.iter().zip(want).all(|(b, w)| (b - w).abs() < 2e-3), "x = {x}: {base:?}, want {want:?}");
+    }
+}
+
+#[test]
+fn a_material_the_scene_draws_without_vertex_colours_binds_no_base_colour_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut gltf = Gltf::new();
+    let plain =
+        gltf.material(json!({ "name": "plain", "pbrMetallicRoughness": { "baseColorFactor": [0.5, 0.5, 0.5, 1.0] } }));
+    let drawn = gltf.mesh("drawn", &[(&plane(1.0), Some(plain))]);
+    gltf.node(json!({ "name": "drawn", "mesh": drawn }));
+    // A mesh with vertex colours in the same material, which no node of the scene places.
+    let mut coloured = plane(1.0);
+    coloured.colors = Some(vec![[1.0, 0.0, 0.0, 1.0]; 4]);
+    gltf.mesh("unplaced", &[(&coloured, Some(plain))]);
+    camera_looking_down_z(&mut gltf, "front", [0.0, 0.0, 1.0 / 20f32.to_radians().tan()], 40.0, 1.0);
+    let path = gltf.write_gltf(dir.path(), "unplaced");
+    let g = bake_file(&path, 16, 1);
+    assert!(g.maps.is_empty(), "{:?}", g.maps.keys());
+    let import = Import::new(&Asset::load(&path).unwrap()).unwrap();
+    assert!(import.materials[0].mapped.maps.is_empty(), "the import binds what the bake writes");
 }
 
 #[test]

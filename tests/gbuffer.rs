@@ -505,6 +505,24 @@ fn maps_are_read_as_colour_and_scalar_maps_in_half_or_float() {
 }
 
 #[test]
+fn maps_no_look_could_name_are_left_out_with_a_warning() {
+    let disc = Disc::new(4, 4);
+    let mut channels = disc.half_normals();
+    channels.push(half("map.map.rough", vec![0.5; 16]));
+    channels.push(half("map. padded", vec![0.5; 16]));
+    channels.push(half("map.fine", vec![0.5; 16]));
+    let path = scratch("odd-map-names.exr");
+    write_exr(&path, disc.size(), channels, Compression::ZIP16, &[]);
+    let (g, warnings) = read_ok(&path);
+    assert_eq!(g.maps.keys().collect::<Vec<_>>(), ["fine"]);
+    assert_eq!(warnings.len(), 2, "{warnings:?}");
+    assert!(warnings
+        .iter()
+        .any(|w| w.contains("ignored channel map.map.rough") && w.contains("without the channel prefix")));
+    assert!(warnings.iter().any(|w| w.contains("ignored channel map. padded") && w.contains("spaces")));
+}
+
+#[test]
 fn non_finite_maps_are_errors_and_out_of_range_maps_are_clamped_with_a_count() {
     let disc = Disc::new(10, 10);
     let mut map = disc.ramp();

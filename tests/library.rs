@@ -312,6 +312,14 @@ fn lint_knows_the_maps_and_presets_saved_from_a_bound_layer_keep_their_factors()
     );
     assert!(out.contains("metallic = 0.5 is in between"), "{out}");
     assert_eq!(out.lines().count(), 1, "{out}");
+    // A bound layer that another covers wholly shows nowhere: no finding.
+    let covered_over = s.write(
+        "covered.toml",
+        "[[object]]\n[[object.layer]]\n[object.layer.set]\nmetallic = 1.0\n[object.layer.map]\nmetallic = \"metal\"\n\
+         [[object.layer]]\npreset = \"gold\"\n",
+    );
+    let o = s.run(&["lint", &covered_over, "--gbuffer", &s.arg("g.exr")]);
+    assert!(o.status.success() && stdout(&o).is_empty(), "{}{}", stdout(&o), stderr(&o));
     // A map the g-buffer lacks is an error, as for a render.
     let missing = s.write("missing.toml", "[[object]]\n[[object.layer]]\n[object.layer.map]\nroughness = \"rough\"\n");
     let o = s.run(&["lint", &missing, "--gbuffer", &s.arg("g.exr")]);

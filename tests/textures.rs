@@ -130,8 +130,8 @@ fn write_asset(dir: &Path) -> PathBuf {
     gltf.write_gltf(dir, "tiles")
 }
 
-/// KHR_texture_transform as the extension's GLSL writes it: translation · rotation · scale, with
-/// rotation = mat3(cos, −sin, 0, sin, cos, 0, 0, 0, 1) (columns).
+/// KHR_texture_transform: translation · rotation · scale, with rotation = mat3(cos, −sin, 0, sin,
+/// cos, 0, 0, 0, 1) (columns), the sign its TextureTransformTest sample asset checks.
 fn transformed((offset, rotation, scale): ([f32; 2], f32, [f32; 2]), uv: [f32; 2]) -> [f32; 2] {
     let (s, c) = rotation.sin_cos();
     let translation = Mat3::from_cols(Vec3::X, Vec3::Y, Vec3::new(offset[0], offset[1], 1.0));

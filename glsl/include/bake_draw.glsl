@@ -5,4 +5,5 @@ layout(push_constant) uniform Draw {
     vec4 toward_eye;        // xyz: the unit direction toward an orthographic camera
     uint object_id;
     uint material;          // the material's place in the material table
+    float lod_bias;         // −½·log2(samples): each sample's texture footprint is its share of the pixel
 } draw;

@@ -18,10 +18,11 @@ const uint SLOTS = 9u;
 // decoded by the sampler. Only the fragment stage samples them.
 layout(set = 0, binding = 0) uniform sampler2D textures[SLOTS];
 
-// The varying locations of the slots' texcoords (one each, from SLOT_TEXCOORDS on) and of the
-// bits of the slots that hold a texture (SLOT_MASK, flat).
+// The varying locations of the slots' texcoords (two slots a location, from SLOT_TEXCOORDS on)
+// and of the bits of the slots that hold a texture (SLOT_MASK, flat).
 #define SLOT_MASK 4
 #define SLOT_TEXCOORDS 5
+#define SLOT_PAIRS 5
 
 // Where a slot samples: texcoord = (dot(u.xyz, (uv, 1)), dot(v.xyz, (uv, 1))), KHR_texture_transform.
 struct TextureSlot {
@@ -35,14 +36,14 @@ struct TextureSlot {
 
 struct Material {
     uint flags;                 // MATERIAL_* below
-    uint maps;                  // the map kinds the maps pass writes: bits of src/asset/materials.rs: MapKind
+    float alpha_cutoff;         // alphaMode MASK: fragments whose alpha is below this are not surface
     float normal_scale;         // normalTexture.scale
-    float alpha_cutoff;         // alphaMode MASK: fragments below this alpha are not surface
     float anisotropy_cos;       // KHR_materials_anisotropy rotation, from the tangent toward the bitangent
     float anisotropy_sin;
     float clearcoat_roughness;  // clearcoatRoughnessFactor
-    float pad;
-    vec4 base_color_factor;     // rgb (for the sheen tint)
+    float pad0;
+    float pad1;
+    vec4 base_color_factor;     // rgb (for the sheen tint), and alpha (for the cut-out)
     vec4 sheen_color_factor;    // rgb
     vec4 specular_color_factor; // rgb
     TextureSlot slots[SLOTS];
@@ -66,8 +67,12 @@ vec2 slot_texcoord(uint slot, vec2 uv0, vec2 uv1) {
     return vec2(dot(s.u.xyz, uv), dot(s.v.xyz, uv));
 }
 
-// Whether an alphaMode MASK material cuts this fragment out: COLOR_0's alpha times the base
-// colour texture's, against the cutoff (which has the factor's alpha divided in).
+// Whether an alphaMode MASK material cuts this fragment out: the base colour's alpha (the
+// factor's times the texture's times COLOR_0's) below the cutoff.
 bool cut_out(vec4 base_color_texel, vec4 color) {
-    return (MATERIAL.flags & MATERIAL_ALPHA_MASK) != 0u && color.a * base_color_texel.a < MATERIAL.alpha_cutoff;
+    float alpha = MATERIAL.base_color_factor.a * base_color_texel.a * color.a;
+    return (MATERIAL.flags & MATERIAL_ALPHA_MASK) != 0u && alpha < MATERIAL.alpha_cutoff;
 }
+
+// A slot's texcoords among the packed pairs: slot 2k in pair k's xy, slot 2k + 1 in its zw.
+#define SLOT_UV(pairs, slot) ((slot) % 2u == 0u ? pairs[(slot) / 2u].xy : pairs[(slot) / 2u].zw)

@@ -47,6 +47,7 @@ struct DrawConstants {
     toward_eye: [f32; 4],
     object_id: u32,
     material: u32,
+    lod_bias: f32,
 }
 
 /// `TextureSlot` in glsl/include/bake_material.glsl.
@@ -65,13 +66,12 @@ struct GpuTextureSlot {
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct GpuMaterial {
     flags: u32,
-    maps: u32,
-    normal_scale: f32,
     alpha_cutoff: f32,
+    normal_scale: f32,
     anisotropy_cos: f32,
     anisotropy_sin: f32,
     clearcoat_roughness: f32,
-    pad: f32,
+    pad: [f32; 2],
     base_color_factor: [f32; 4],
     sheen_color_factor: [f32; 4],
     specular_color_factor: [f32; 4],
@@ -90,9 +90,21 @@ const GEOMETRY_TARGETS: [vk::Format; 5] = [
     vk::Format::R32G32B32A32_SFLOAT, // COLOR_0
 ];
 
-/// The maps pass's render targets (bake_maps.frag), which [`MAP_CHANNELS`] lays out. Half floats
-/// hold 8-bit texels and material numbers exactly enough, at half the bandwidth.
-const MAP_TARGETS: [vk::Format; 4] = [vk::Format::R16G16B16A16_SFLOAT; 4];
+/// The maps pass's render targets (bake_maps.frag): four that [`MAP_CHANNELS`] lays out, in half
+/// floats, which hold 8-bit texels exactly enough at half the bandwidth, and the material of each
+/// sample.
+const MAP_TARGETS: [vk::Format; 5] = [
+    vk::Format::R16G16B16A16_SFLOAT,
+    vk::Format::R16G16B16A16_SFLOAT,
+    vk::Format::R16G16B16A16_SFLOAT,
+    vk::Format::R16G16B16A16_SFLOAT,
+    vk::Format::R32_UINT, // the material's index + 1; 0 for none
+];
+
+/// The GPU layouts, as the GLSL declares them (std430 and push constants).
+const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 512);
+const _: () = assert!(std::mem::size_of::<GpuTextureSlot>() == 48);
+const _: () = assert!(std::mem::size_of::<DrawConstants>() == 108);
 
 /// The steps of a bake, for progress reports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -131,7 +143,7 @@ pub fn bake(
     }
     let camera = camera::choose(asset, &options.camera, geometry.bounds, width, height)?;
     let used = materials::used(asset, geometry.draws.iter().map(|d| d.material));
-    for warning in asset.unread_texcoords() {
+    for warning in asset.unread_texcoords(used.iter().map(|m| material_of(asset, m.index))) {
         crate::warn(format!("{}: {warning}", asset.path.display()));
     }
     // The map kinds of each used material: a base colour map where its primitives carry COLOR_0.
@@ -151,7 +163,7 @@ pub fn bake(
             ctx.info().max_color_attachments,
         )));
     }
-    let rasterizer = Rasterizer::new(ctx, asset, &geometry, &used, &kinds, width, height)?;
+    let rasterizer = Rasterizer::new(ctx, asset, &geometry, &used, &kinds, (width, height, options.samples))?;
     let mut accumulator = Accumulator::new(width, height, &kinds, &geometry);
     for (pass, offset) in jitter_pattern(options.samples).into_iter().enumerate() {
         let samples = rasterizer.pass(&geometry, &camera, offset)?;
@@ -205,6 +217,8 @@ struct Rasterizer {
     sets: Vec<(TextureSet, Option<TextureSet>)>,
     /// Per used material: whether its back faces are drawn.
     double_sided: Vec<bool>,
+    /// Textures are sampled for each sample's share of the pixel: −½·log2(samples) levels finer.
+    lod_bias: f32,
     /// A draw's glTF material index to its place among the used materials.
     slot_of: HashMap<Option<usize>, usize>,
     /// The geometry targets, then the maps targets.
@@ -226,8 +240,9 @@ struct Samples<'a> {
     view: &'a [[f32; 4]],
     ids: &'a [[u32; 2]],
     color: &'a [[f32; 4]],
-    /// The maps pass's targets, when it ran.
+    /// The maps pass's targets, when it ran: the four of values, and each sample's material.
     maps: Vec<&'a [[f16; 4]]>,
+    map_material: &'a [u32],
 }
 
 /// The sampler a glTF texture asks for: its filters and wrap modes, with mip mapping unless its
@@ -256,11 +271,7 @@ fn sampler_desc(sampler: &gltf::texture::Sampler) -> SamplerDesc {
 }
 
 /// The GPU's view of one material: its constants and where each slot samples.
-fn gpu_material(
-    material: &gltf::Material,
-    kinds: &[MapKind],
-    references: &[Option<textures::TextureRef>],
-) -> GpuMaterial {
+fn gpu_material(material: &gltf::Material, references: &[Option<textures::TextureRef>]) -> GpuMaterial {
     let pbr = material.pbr_metallic_roughness();
     let mut flags = 0;
     if material.double_sided() {
@@ -296,14 +307,8 @@ fn gpu_material(
     }
     GpuMaterial {
         flags,
-        maps: kinds.iter().map(|k| k.bit()).sum(),
+        alpha_cutoff: material.alpha_cutoff().unwrap_or(0.5),
         normal_scale: material.normal_texture().map_or(1.0, |t| t.scale()),
-        // The shader compares COLOR_0's alpha times the texture's; dividing the cutoff by the
-        // factor's alpha brings that in too.
-        alpha_cutoff: match factor[3] {
-            f if f > 0.0 => material.alpha_cutoff().unwrap_or(0.5) / f,
-            _ => f32::MAX,
-        },
         anisotropy_cos: rotation.cos(),
         anisotropy_sin: rotation.sin(),
         clearcoat_roughness: material
@@ -311,7 +316,7 @@ fn gpu_material(
             .and_then(|e| e.get("clearcoatRoughnessFactor"))
             .and_then(|v| v.as_f64())
             .unwrap_or(0.0) as f32,
-        pad: 0.0,
+        pad: [0.0; 2],
         base_color_factor: factor,
         sheen_color_factor: extension_color("KHR_materials_sheen", "sheenColorFactor", [0.0; 3]),
         specular_color_factor: {
@@ -329,8 +334,7 @@ impl Rasterizer {
         geometry: &Geometry,
         used: &[UsedMaterial],
         kinds: &[Vec<MapKind>],
-        width: u32,
-        height: u32,
+        (width, height, samples): (u32, u32, u32),
     ) -> Result<Rasterizer> {
         let attribute = |location, format, offset| Attribute { location, format, offset };
         let f32x = |n: usize| match n {
@@ -393,10 +397,10 @@ impl Rasterizer {
         let mut sampler_of: HashMap<SamplerDesc, usize> = HashMap::new();
         let mut gpu_materials = Vec::new();
         let mut bindings = Vec::new();
-        for (used_material, kinds) in used.iter().zip(kinds) {
+        for used_material in used {
             let material = material_of(asset, used_material.index);
             let references = textures::material_textures(&material);
-            gpu_materials.push(gpu_material(&material, kinds, &references));
+            gpu_materials.push(gpu_material(&material, &references));
             let mut binding = [(white, 0usize); SLOTS];
             binding[Slot::Normal as usize].0 = flat;
             for (slot, reference) in Slot::ALL.into_iter().zip(references) {
@@ -446,6 +450,7 @@ impl Rasterizer {
             vertices,
             sets,
             double_sided: gpu_materials.iter().map(|m| m.flags & MATERIAL_DOUBLE_SIDED != 0).collect(),
+            lod_bias: -0.5 * (samples as f32).log2(),
             slot_of: used.iter().enumerate().map(|(slot, m)| (m.index, slot)).collect(),
             targets,
             depth,
@@ -508,6 +513,7 @@ impl Rasterizer {
                         toward_eye: [toward_eye.x, toward_eye.y, toward_eye.z, 0.0],
                         object_id: draw.object_id,
                         material: slot as u32,
+                        lod_bias: self.lod_bias,
                     };
                     let (geometry_set, maps_set) = &self.sets[slot];
                     let set =
@@ -546,7 +552,11 @@ impl Rasterizer {
             view: bytemuck::cast_slice(next(16)),
             ids: bytemuck::cast_slice(next(8)),
             color: bytemuck::cast_slice(next(16)),
-            maps: (GEOMETRY_TARGETS.len()..self.targets.len()).map(|_| bytemuck::cast_slice(next(8))).collect(),
+            maps: (0..self.maps_pipeline.as_ref().map_or(0, |_| 4)).map(|_| bytemuck::cast_slice(next(8))).collect(),
+            map_material: match self.maps_pipeline {
+                Some(_) => bytemuck::cast_slice(next(4)),
+                None => &[],
+            },
         })
     }
 }
@@ -627,11 +637,9 @@ impl Accumulator {
                 color[p] += Vec4::from(s.color[p]);
             }
         }
-        // The maps pass's samples, each counted for the material it names (its alpha).
-        let Some(named) = s.maps.first() else { return };
-        for p in 0..self.hits.len() {
-            let material = named[p][3].to_f32() as usize;
-            let Some(&kinds) = material.checked_sub(1).and_then(|slot| self.material_kinds.get(slot)) else {
+        // The maps pass's samples, each counted for the material it names.
+        for (p, &material) in s.map_material.iter().enumerate() {
+            let Some(&kinds) = (material as usize).checked_sub(1).and_then(|slot| self.material_kinds.get(slot)) else {
                 continue;
             };
             for (kind, hits) in &mut self.kind_hits {
@@ -670,12 +678,26 @@ impl Accumulator {
             coverage.push(hits as f32 / self.samples as f32);
             object_id.push(if hits > 0 { self.vote[p].0 } else { 0 });
         }
-        let share = |count: &[u16]| -> Vec<f32> {
-            count.iter().zip(&self.hits).map(|(&c, &h)| if h > 0 { c as f32 / h as f32 } else { 0.0 }).collect()
-        };
+        // Each material's mask is its weight over the materials before it, in the order the
+        // import stacks their layers: its hits over its own and theirs. Blended in that order, the
+        // layers then take exactly their shares of the pixel, however many meet there.
         let mut masks = BTreeMap::new();
+        let mut below = vec![0u32; pixels];
         for (slot, material) in used.iter().enumerate() {
-            masks.insert(material.channel.clone(), share(&self.material_hits[slot]));
+            let hits = &self.material_hits[slot];
+            let weights = hits
+                .iter()
+                .zip(below.iter_mut())
+                .map(|(&h, below)| {
+                    *below += h as u32;
+                    if *below > 0 {
+                        h as f32 / *below as f32
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            masks.insert(material.channel.clone(), weights);
         }
         // Each map is the mean over the samples of the materials that write it: where a textured
         // material meets another, the map holds the textured one's value for its layer.

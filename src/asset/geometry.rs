@@ -218,11 +218,14 @@ fn read_primitive(asset: &Asset, mesh: &gltf::Mesh, primitive: &gltf::Primitive)
         flat_normals(&mut vertices);
     }
     if tangents.is_none() {
-        // MikkTSpace follows the normal map's texcoords; glTF normal maps use set 0 unless told.
-        let set = primitive.material().normal_texture().map_or(0, |t| t.tex_coord());
+        // MikkTSpace follows the normal map's texcoords, as the bake samples it: its set (set 0
+        // unless told) under its KHR_texture_transform, so the frame turns with the texture.
+        let material = primitive.material();
+        let normal_map = super::textures::material_textures(&material)[super::textures::Slot::Normal as usize];
+        let (set, transform) = normal_map.map_or((0, None), |r| (r.tex_coord, Some(r.transform)));
         let has_set = if set == 1 { uv1.is_some() } else { uv0.is_some() };
         if has_set {
-            generate_tangents(&mut vertices, set == 1);
+            generate_tangents(&mut vertices, set == 1, transform);
         }
     }
     Ok(Triangles { vertices, has_colors: colors.is_some() })
@@ -276,12 +279,13 @@ fn flat_normals(vertices: &mut [Vertex]) {
     }
 }
 
-/// MikkTSpace tangents for unindexed triangles, from texcoord set 0 (or 1), with the bitangent
-/// pointing up the image.
-fn generate_tangents(vertices: &mut [Vertex], second_set: bool) {
+/// MikkTSpace tangents for unindexed triangles, from texcoord set 0 (or 1) under `transform`
+/// (the rows of a 2×3 texture transform), with the bitangent pointing up the image.
+fn generate_tangents(vertices: &mut [Vertex], second_set: bool, transform: Option<[[f32; 3]; 2]>) {
     struct Mesh<'a> {
         vertices: &'a mut [Vertex],
         second_set: bool,
+        transform: [[f32; 3]; 2],
     }
     impl MikkGeometry for Mesh<'_> {
         fn num_faces(&self) -> usize {
@@ -298,7 +302,9 @@ fn generate_tangents(vertices: &mut [Vertex], second_set: bool) {
         }
         fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
             let v = &self.vertices[face * 3 + vert];
-            let [s, t] = if self.second_set { v.uv1 } else { v.uv0 };
+            let [u, v] = if self.second_set { v.uv1 } else { v.uv0 };
+            let [row0, row1] = self.transform;
+            let (s, t) = (row0[0] * u + row0[1] * v + row0[2], row1[0] * u + row1[1] * v + row1[2]);
             // glTF's v runs down the image and its normal maps' +Y points up it: MikkTSpace
             // works with v up, as the tangents exporters write do.
             [s, 1.0 - t]
@@ -313,7 +319,8 @@ fn generate_tangents(vertices: &mut [Vertex], second_set: bool) {
         }
     }
     // A mesh MikkTSpace rejects (nothing but degenerate triangles) keeps no tangents.
-    let _ = bevy_mikktspace::generate_tangents(&mut Mesh { vertices, second_set });
+    let transform = transform.unwrap_or([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    let _ = bevy_mikktspace::generate_tangents(&mut Mesh { vertices, second_set, transform });
 }
 
 /// Appends a primitive's vertices in world space.

@@ -41,7 +41,12 @@ impl Import {
     pub fn new(asset: &Asset) -> Result<Import> {
         let primitives = primitives(asset)?;
         let used = materials::used(asset, primitives.iter().map(|(_, p)| p.material().index()));
-        let colored = materials::with_vertex_colors(asset);
+        // As the bake sees them: the scene's primitives that carry COLOR_0.
+        let colored: Vec<Option<usize>> = primitives
+            .iter()
+            .filter(|(_, p)| p.get(&gltf::Semantic::Colors(0)).is_some())
+            .map(|(_, p)| p.material().index())
+            .collect();
         let source =
             asset.path.file_name().map_or_else(|| asset.path.display().to_string(), |n| n.to_string_lossy().into());
         let materials = used
@@ -51,7 +56,9 @@ impl Import {
                 let mapped = materials::map(&material, colored.contains(&used.index));
                 let mut description = format!("'{}' from {source}.", used.label);
                 for note in &mapped.notes {
-                    description.push_str(&format!(" {}{}.", note[..1].to_uppercase(), &note[1..]));
+                    let mut letters = note.chars();
+                    let first: String = letters.next().map(|c| c.to_uppercase().collect()).unwrap_or_default();
+                    description.push_str(&format!(" {first}{}.", letters.as_str()));
                 }
                 let preset = Preset {
                     name: used.preset.clone(),

@@ -154,21 +154,6 @@ impl MapKind {
     }
 }
 
-/// The materials (by glTF index, `None` for the default material) used by a primitive with
-/// `COLOR_0`: their base colour varies per vertex, so it is a map.
-pub fn with_vertex_colors(asset: &Asset) -> Vec<Option<usize>> {
-    let mut materials: Vec<Option<usize>> = asset
-        .document
-        .meshes()
-        .flat_map(|m| m.primitives())
-        .filter(|p| p.get(&gltf::Semantic::Colors(0)).is_some())
-        .map(|p| p.material().index())
-        .collect();
-    materials.sort_unstable();
-    materials.dedup();
-    materials
-}
-
 /// The map kinds a material needs: one for each of its textures that drives a parameter, and
 /// base colour too where `COLOR_0` tints it.
 pub fn map_kinds(material: &gltf::Material, vertex_colors: bool) -> Vec<MapKind> {
@@ -328,6 +313,12 @@ pub fn map(material: &gltf::Material, vertex_colors: bool) -> Mapped {
         }
         if a.textured {
             notes.push("the anisotropy texture is not carried over".into());
+        }
+        if maps.contains(&MapKind::MetallicRoughness) && a.strength > 0.0 {
+            notes.push(
+                "anisotropic is fitted to the roughness factor; where the roughness map is lower, the highlight is less stretched than glTF's"
+                    .into(),
+            );
         }
     }
     if material.occlusion_texture().is_some() {

@@ -46,19 +46,33 @@ const COMPRESSION: [(&str, &str); 3] = [
     ("KHR_meshopt_compression", "meshopt compression"),
 ];
 
+/// Whether loading an asset decodes its textures' images or only checks them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Texels {
+    Decode,
+    Check,
+}
+
 /// A glTF asset with its buffers and images, checked.
 pub struct Asset {
     pub path: PathBuf,
     pub document: gltf::Document,
     pub buffers: Vec<Vec<u8>>,
     /// Decoded images by index, RGBA8 as stored (sRGB-encoded colour, linear data); `None` for
-    /// an image no material uses.
+    /// an image no material uses, and for every image when loaded with [`Texels::Check`].
     pub images: Vec<Option<RgbaImage>>,
 }
 
 impl Asset {
-    /// Reads a `.gltf` (with its external or embedded buffers and images) or a `.glb`.
+    /// Reads a `.gltf` (with its external or embedded buffers and images) or a `.glb`, and
+    /// decodes the images its materials use, for the bake.
     pub fn load(path: &Path) -> Result<Asset> {
+        Asset::load_with(path, Texels::Decode)
+    }
+
+    /// Reads an asset; with [`Texels::Check`], the images its materials use are read and their
+    /// format recognised but not decoded (what the import needs: it reads no texel).
+    pub fn load_with(path: &Path, texels: Texels) -> Result<Asset> {
         let bytes = std::fs::read(path).map_err(|e| Error::input_file(path, format!("cannot read ({e})")))?;
         let gltf = gltf::Gltf::from_slice_without_validation(&bytes)
             .map_err(|e| Error::input_file(path, format!("not a readable glTF file ({e})")))?;
@@ -77,12 +91,12 @@ impl Asset {
             .collect::<Result<Vec<_>>>()?;
         let mut asset = Asset { path: path.to_path_buf(), document, buffers, images: Vec::new() };
         asset.check_extension_textures()?;
-        asset.images = asset.load_images(folder)?;
+        asset.images = asset.load_images(folder, texels)?;
         Ok(asset)
     }
 
     /// The extensions' textureInfos are JSON the `gltf` crate does not check: each must name a
-    /// texture of the file, and a texcoord set the bake reads.
+    /// texture of the file.
     fn check_extension_textures(&self) -> Result<()> {
         let count = self.document.textures().len();
         for material in self.document.materials() {
@@ -113,11 +127,11 @@ impl Asset {
         Ok(())
     }
 
-    /// The texture references of a material that name a texcoord set beyond TEXCOORD_1, which
-    /// the bake does not read: each is sampled with TEXCOORD_0 instead, and reported.
-    pub fn unread_texcoords(&self) -> Vec<String> {
+    /// The texture references of these materials that name a texcoord set beyond TEXCOORD_1,
+    /// which the bake does not read: each is sampled with TEXCOORD_0 instead, and reported.
+    pub fn unread_texcoords<'a>(&self, materials: impl IntoIterator<Item = gltf::Material<'a>>) -> Vec<String> {
         let mut found = Vec::new();
-        for material in self.document.materials() {
+        for material in materials {
             for (slot, reference) in textures::Slot::ALL.iter().zip(textures::material_textures(&material)) {
                 if let Some(reference) = reference.filter(|r| r.tex_coord > 1) {
                     found.push(format!(
@@ -132,8 +146,8 @@ impl Asset {
         found
     }
 
-    /// The images materials use, decoded.
-    fn load_images(&self, folder: &Path) -> Result<Vec<Option<RgbaImage>>> {
+    /// The images materials use, decoded (or, with [`Texels::Check`], checked and left out).
+    fn load_images(&self, folder: &Path, texels: Texels) -> Result<Vec<Option<RgbaImage>>> {
         let mut used = vec![false; self.document.images().len()];
         for material in self.document.materials() {
             for reference in textures::material_textures(&material).into_iter().flatten() {
@@ -144,13 +158,13 @@ impl Asset {
         self.document
             .images()
             .map(|image| match used[image.index()] {
-                true => self.load_image(folder, &image).map(Some),
+                true => self.load_image(folder, &image, texels),
                 false => Ok(None),
             })
             .collect()
     }
 
-    fn load_image(&self, folder: &Path, image: &gltf::Image) -> Result<RgbaImage> {
+    fn load_image(&self, folder: &Path, image: &gltf::Image, texels: Texels) -> Result<Option<RgbaImage>> {
         let label = match image.name() {
             Some(name) => format!("image {} '{name}'", image.index()),
             None => format!("image {}", image.index()),
@@ -168,14 +182,19 @@ impl Asset {
             }
             gltf::image::Source::Uri { uri, .. } => read_uri(&self.path, folder, uri, &label)?,
         };
+        if texels == Texels::Check {
+            image::guess_format(&bytes)
+                .map_err(|e| Error::input_file(&self.path, format!("{label} cannot be decoded ({e})")))?;
+            return Ok(None);
+        }
         let decoded = image::load_from_memory(&bytes)
             .map_err(|e| Error::input_file(&self.path, format!("{label} cannot be decoded ({e})")))?;
-        Ok(decoded.into_rgba8())
+        Ok(Some(decoded.into_rgba8()))
     }
 
-    /// The decoded image a texture shows.
+    /// The decoded image a texture shows, of an asset loaded with [`Texels::Decode`].
     pub fn texture_image(&self, texture: &gltf::Texture) -> &RgbaImage {
-        self.images[texture.source().index()].as_ref().expect("every image a material uses is loaded")
+        self.images[texture.source().index()].as_ref().expect("an asset for the bake decodes every image it uses")
     }
 
     /// The extensions the file uses that lookdev ignores, each with what uses it: reported, so
@@ -224,7 +243,14 @@ fn check_texture_formats(path: &Path, json: &gltf::json::Root) -> Result<()> {
             ),
         )
     };
-    for (index, texture) in json.textures.iter().enumerate() {
+    // Only the textures materials use: an unused one is never read.
+    let mut used = Vec::new();
+    for material in &json.materials {
+        if let Ok(value) = gltf::json::serialize::to_value(material) {
+            textures::texture_indices(&value, &mut used);
+        }
+    }
+    for (index, texture) in json.textures.iter().enumerate().filter(|(i, _)| used.contains(&(*i as u64))) {
         let source = texture.source.value();
         match json.images.get(source) {
             Some(image) => {

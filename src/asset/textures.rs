@@ -84,9 +84,10 @@ pub struct TextureRef {
 /// The identity transform.
 const IDENTITY: [[f32; 3]; 2] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
 
-/// KHR_texture_transform's matrix, translation · rotation · scale, with the rotation's sign as
-/// the ratified extension and its TextureTransformTest sample give it: u' = cos·sx·u + sin·sy·v
-/// + ox, v' = −sin·sx·u + cos·sy·v + oy.
+/// KHR_texture_transform's matrix, translation · rotation · scale: u' = cos·sx·u + sin·sy·v + ox,
+/// v' = −sin·sx·u + cos·sy·v + oy. The rotation's sign is the one the TextureTransformTest sample
+/// asset checks (its arrows reach their green markers) and the sample viewers use; the GLSL
+/// listing in the extension's text reads the other way.
 pub fn transform_matrix(offset: [f32; 2], rotation: f32, scale: [f32; 2]) -> [[f32; 3]; 2] {
     let (sin, cos) = rotation.sin_cos();
     [[cos * scale[0], sin * scale[1], offset[0]], [-sin * scale[0], cos * scale[1], offset[1]]]
@@ -133,6 +134,25 @@ impl TextureRef {
             tex_coord: t.get("texCoord").and_then(Value::as_u64).map_or(self.tex_coord, |c| c as u32),
             ..self
         }
+    }
+}
+
+/// The texture indices of every textureInfo in a material's JSON (a `…Texture` key holding an
+/// `index`), core and extensions alike, appended to `out`.
+pub fn texture_indices(value: &Value, out: &mut Vec<u64>) {
+    match value {
+        Value::Object(map) => {
+            for (key, inner) in map {
+                if let Some(index) =
+                    key.ends_with("Texture").then(|| inner.get("index")).flatten().and_then(Value::as_u64)
+                {
+                    out.push(index);
+                }
+                texture_indices(inner, out);
+            }
+        }
+        Value::Array(items) => items.iter().for_each(|item| texture_indices(item, out)),
+        _ => {}
     }
 }
 
@@ -233,6 +253,35 @@ mod tests {
         assert!((u - 0.5).abs() < 1e-6 && (v - (0.25 - 2.0)).abs() < 1e-6, "{u} {v}");
         let (u, v) = apply(0.0, 1.0);
         assert!((u - (0.5 + 3.0)).abs() < 1e-6 && (v - 0.25).abs() < 1e-6, "{u} {v}");
+    }
+
+    /// The TextureTransformTest sample asset: each quad spans [−½, ½]² with its uv (0, 0) at the
+    /// top left, and shows a texture whose arrow tip is at uv (0.778, 0.778); its "Correct"
+    /// marker, in the quad's frame, is where the tip lands when the transform is right, its
+    /// "Error" marker where a rotation the other way puts it.
+    #[test]
+    fn the_arrows_of_texture_transform_test_reach_their_correct_markers() {
+        let tip = [0.778, 0.778];
+        let shown_at = |m: [[f32; 3]; 2], [x, y]: [f32; 2]| {
+            let (u, v) = (x + 0.5, 0.5 - y);
+            [m[0][0] * u + m[0][1] * v + m[0][2], m[1][0] * u + m[1][1] * v + m[1][2]]
+        };
+        let lands = |m, marker, tolerance: f32| {
+            let uv = shown_at(m, marker);
+            (uv[0] - tip[0]).abs() < tolerance && (uv[1] - tip[1]).abs() < tolerance
+        };
+        // The sample's rotation, 0.39269908169872414: π/8.
+        let rotation = transform_matrix([0.0, 0.0], std::f32::consts::FRAC_PI_8, [1.0, 1.0]);
+        assert!(
+            lands(rotation, [-0.079_048_22, -0.516_267_5], 0.002),
+            "Rotation: {:?}",
+            shown_at(rotation, [-0.079, -0.516])
+        );
+        assert!(!lands(rotation, [0.516_267_5, 0.079_048_22], 0.1), "Rotation points at its Error marker");
+        let scale = transform_matrix([0.0, 0.0], 0.0, [1.5, 1.5]);
+        assert!(lands(scale, [0.018_544_97, -0.018_544_97], 0.002));
+        let all = transform_matrix([-0.2, -0.1], 0.3, [1.5, 1.5]);
+        assert!(lands(all, [-0.07, -0.25], 0.03), "All: {:?}", shown_at(all, [-0.07, -0.25]));
     }
 
     #[test]

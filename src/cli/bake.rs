@@ -36,7 +36,7 @@ pub struct BakeArgs {
     /// Framing vertical field of view in degrees.
     #[arg(long, value_name = "DEG", requires = "auto_camera")]
     pub fov: Option<f32>,
-    /// Samples per pixel for antialiased coverage, normals and masks (1 to 1024).
+    /// Samples per pixel for antialiased coverage, normals, masks and maps (1 to 1024).
     #[arg(long, default_value_t = 16)]
     pub samples: u32,
     /// Vulkan device to use: part of its name (lavapipe is "llvmpipe").
@@ -106,12 +106,13 @@ pub fn run(args: BakeArgs) -> Result<()> {
     gbuffer.write(&args.out)?;
     if !args.quiet {
         eprintln!(
-            "lookdev: wrote {} ({}x{}, {} objects, {} masks, {} samples, {:.2} s on {device_name})",
+            "lookdev: wrote {} ({}x{}, {} objects, {} masks, {} maps, {} samples, {:.2} s on {device_name})",
             args.out.display(),
             gbuffer.width,
             gbuffer.height,
             gbuffer.object_names.len(),
             gbuffer.masks.len(),
+            gbuffer.maps().len(),
             args.samples,
             start.elapsed().as_secs_f64()
         );

@@ -26,7 +26,7 @@ pub struct ImportArgs {
 }
 
 pub fn run(args: ImportArgs) -> Result<()> {
-    let asset = Asset::load(&args.model)?;
+    let asset = Asset::load_with(&args.model, crate::asset::Texels::Check)?;
     let import = Import::new(&asset)?;
     if !import.unsupported.is_empty() {
         crate::warn(format!(

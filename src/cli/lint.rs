@@ -3,8 +3,8 @@
 //! Every layer's resolved parameters (its preset with its overrides) are checked. A parameter
 //! bound to a map holds a factor, not a value, so the rules that read it are left out; with
 //! `--gbuffer`, the masks and maps the look names must be in the g-buffer (as for a render), and
-//! the bound layers are checked at every covered pixel where they show (blend weight at least
-//! 0.5), with the factor times the map: a finding there gives the share of those pixels. A look
+//! the bound layers are checked at every covered pixel where they show (making at least half of
+//! the result), with the factor times the map: a finding there gives the share of those pixels. A look
 //! that passes prints nothing and exits 0; findings are printed one per line, `FILE:LINE: object,
 //! layer: finding`, and the exit code is 1. A look or g-buffer that cannot be read is an error
 //! (exit 2).
@@ -57,39 +57,52 @@ pub const DIELECTRIC_ALBEDO: (f32, f32) = (0.02, 0.9);
 pub const METAL_F0_MIN: f32 = 0.45;
 pub const SPECULAR_MAX: f32 = 1.0;
 
+impl Rule {
+    pub const ALL: [Rule; 4] =
+        [Rule::MetallicInBetween, Rule::DielectricAlbedo, Rule::MetalReflectance, Rule::SpecularAboveOne];
+
+    /// Whether the rule finds these parameters implausible.
+    pub fn fails(self, params: &Params) -> bool {
+        let m = params.metallic;
+        let lum = luminance(Vec3::from(params.base_color));
+        match self {
+            Rule::MetallicInBetween => m > 0.0 && m < 1.0,
+            Rule::DielectricAlbedo => m < 0.5 && !(DIELECTRIC_ALBEDO.0..=DIELECTRIC_ALBEDO.1).contains(&lum),
+            Rule::MetalReflectance => m >= 0.5 && lum < METAL_F0_MIN,
+            Rule::SpecularAboveOne => params.specular > SPECULAR_MAX,
+        }
+    }
+
+    /// What the rule found in parameters it fails, with the reason.
+    pub fn finding(self, params: &Params) -> String {
+        let m = params.metallic;
+        let lum = luminance(Vec3::from(params.base_color));
+        match self {
+            Rule::MetallicInBetween => format!(
+                "metallic = {m} is in between: a surface is a metal or it is not; blend a metal layer in through a mask instead"
+            ),
+            Rule::DielectricAlbedo => format!(
+                "base_color luminance {lum:.3} is outside [{}, {}] for a dielectric: charcoal reflects about 0.04 and fresh snow about 0.9",
+                DIELECTRIC_ALBEDO.0, DIELECTRIC_ALBEDO.1
+            ),
+            Rule::MetalReflectance => format!(
+                "metal F0 (base_color) luminance {lum:.3} is below {METAL_F0_MIN}: darker than any common metal at normal incidence"
+            ),
+            Rule::SpecularAboveOne => {
+                let f0 = 0.08 * params.specular;
+                let ior = (1.0 + f0.sqrt()) / (1.0 - f0.sqrt());
+                format!(
+                    "specular = {} is above 1: F0 {f0:.3}, an IOR of {ior:.2}, more than almost any dielectric but gems",
+                    params.specular
+                )
+            }
+        }
+    }
+}
+
 /// The findings for one set of parameters, with the rule behind each.
 pub fn findings(params: &Params) -> Vec<(Rule, String)> {
-    let mut findings = Vec::new();
-    let m = params.metallic;
-    let lum = luminance(Vec3::from(params.base_color));
-    if m > 0.0 && m < 1.0 {
-        findings.push((Rule::MetallicInBetween, format!(
-            "metallic = {m} is in between: a surface is a metal or it is not; blend a metal layer in through a mask instead"
-        )));
-    }
-    if m < 0.5 && !(DIELECTRIC_ALBEDO.0..=DIELECTRIC_ALBEDO.1).contains(&lum) {
-        findings.push((Rule::DielectricAlbedo, format!(
-            "base_color luminance {lum:.3} is outside [{}, {}] for a dielectric: charcoal reflects about 0.04 and fresh snow about 0.9",
-            DIELECTRIC_ALBEDO.0, DIELECTRIC_ALBEDO.1
-        )));
-    }
-    if m >= 0.5 && lum < METAL_F0_MIN {
-        findings.push((Rule::MetalReflectance, format!(
-            "metal F0 (base_color) luminance {lum:.3} is below {METAL_F0_MIN}: darker than any common metal at normal incidence"
-        )));
-    }
-    if params.specular > SPECULAR_MAX {
-        let f0 = 0.08 * params.specular;
-        let ior = (1.0 + f0.sqrt()) / (1.0 - f0.sqrt());
-        findings.push((
-            Rule::SpecularAboveOne,
-            format!(
-                "specular = {} is above 1: F0 {f0:.3}, an IOR of {ior:.2}, more than almost any dielectric but gems",
-                params.specular
-            ),
-        ));
-    }
-    findings
+    Rule::ALL.into_iter().filter(|r| r.fails(params)).map(|r| (r, r.finding(params))).collect()
 }
 
 /// A bound layer's findings at the g-buffer's pixels: each rule that fails at more than this
@@ -134,9 +147,10 @@ pub fn run(args: LintArgs) -> Result<()> {
 }
 
 /// The findings of the rules that read a bound parameter, for layer `index` of `stack`, over the
-/// covered pixels of the objects that stack shades where the layer's blend weight is at least
-/// 0.5: the layer's own material there (its values times its maps), each rule reported with the
-/// share of those pixels it fails at and the first failing value.
+/// covered pixels of the objects that stack shades where the layer makes at least half of the
+/// result (its share, after the layers above it): the layer's own material there (its values
+/// times its maps), each rule reported with the share of those pixels it fails at and the first
+/// failing value.
 fn pixel_findings(
     look: &Look,
     stack: &ObjectStack,
@@ -152,36 +166,36 @@ fn pixel_findings(
     let Ok(packed) = PackedStacks::pack(&lone, covered_object_ids(gbuffer), gbuffer, std::path::Path::new("")) else {
         return Vec::new();
     };
+    let rules: Vec<Rule> = Rule::ALL.into_iter().filter(|&r| !unbound(r)).collect();
     let mut shown = 0usize;
-    let mut failed: Vec<(Rule, usize, String)> = Vec::new();
+    // Per rule: the pixels it fails at, and the material at the first of them.
+    let mut failed: Vec<(usize, Option<Params>)> = vec![(0, None); rules.len()];
     for p in 0..gbuffer.pixel_count() {
         let id = gbuffer.object_id[p];
         if gbuffer.coverage[p] <= 0.0 || !look.stack_for(id).is_some_and(|s| std::ptr::eq(s, stack)) {
             continue;
         }
         let mask_value = |name: &str| gbuffer.masks.get(name).map_or(0.0, |m| m[p]);
-        let weight = layer_weights(stack, mask_value)[index].map_or(0.0, |w| w.blend);
-        if weight < 0.5 {
+        if layer_weights(stack, mask_value)[index].is_none_or(|w| w.contribution < 0.5) {
             continue;
         }
         shown += 1;
-        for (rule, text) in findings(&packed.resolve_gbuffer_pixel(gbuffer, p)) {
-            if unbound(rule) {
-                continue;
-            }
-            match failed.iter_mut().find(|(r, _, _)| *r == rule) {
-                Some(entry) => entry.1 += 1,
-                None => failed.push((rule, 1, text)),
+        let params = packed.resolve_gbuffer_pixel(gbuffer, p);
+        for (rule, (count, first)) in rules.iter().zip(failed.iter_mut()) {
+            if rule.fails(&params) {
+                *count += 1;
+                first.get_or_insert(params);
             }
         }
     }
-    failed.sort();
-    failed
-        .into_iter()
-        .filter(|&(_, n, _)| n as f32 > PIXEL_SHARE * shown as f32)
-        .map(|(_, n, text)| {
+    rules
+        .iter()
+        .zip(failed)
+        .filter(|&(_, (n, _))| n as f32 > PIXEL_SHARE * shown as f32)
+        .filter_map(|(rule, (n, first))| {
             let share = 100.0 * n as f32 / shown as f32;
-            format!("with its maps, {share:.1}% of the {shown} pixels where it shows fail; the first: {text}")
+            let text = rule.finding(&first?);
+            Some(format!("with its maps, {share:.1}% of the {shown} pixels where it shows fail; the first: {text}"))
         })
         .collect()
 }

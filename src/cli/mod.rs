@@ -34,10 +34,11 @@ pub enum Command {
     Render(render::RenderArgs),
     /// Write the built-in look-dev g-buffer to an EXR.
     Gbuffer(gbuffer::GbufferArgs),
-    /// Rasterize a glTF asset into a g-buffer: normals, tangents, view vectors, ids and masks.
+    /// Rasterize a glTF asset into a g-buffer: normals, tangents, view vectors, ids, masks, and
+    /// maps of its textures.
     Bake(bake::BakeArgs),
     /// Write a glTF asset's materials as presets, and a look that layers them through the
-    /// bake's masks.
+    /// bake's masks and binds its maps.
     Import(import::ImportArgs),
     /// The preset library: list, show, save, and a contact sheet of every preset.
     Presets(presets::PresetsArgs),

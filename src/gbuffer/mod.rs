@@ -135,6 +135,25 @@ pub struct GBuffer {
     pub has_tangent: bool,
 }
 
+/// Whether `name` can name a map in a look: not empty, no spaces around it, no control
+/// characters, and without the channel prefix `map.` (which a look leaves out). The g-buffer's
+/// map channels whose names fail this are left out of the g-buffer, with a warning.
+pub fn check_map_name(name: &str) -> Result<(), String> {
+    if name.is_empty() {
+        return Err("a map's name must not be empty".into());
+    }
+    if name.trim() != name {
+        return Err(format!("{name:?}: a map's name has no spaces around it"));
+    }
+    if name.chars().any(char::is_control) {
+        return Err(format!("{name:?}: a map's name has no control characters"));
+    }
+    if let Some(stripped) = name.strip_prefix(MAP_PREFIX) {
+        return Err(format!("{name:?}: name the map without the channel prefix, as \"{stripped}\""));
+    }
+    Ok(())
+}
+
 /// A map in a g-buffer, as a look names it.
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub struct MapInfo {

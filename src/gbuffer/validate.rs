@@ -11,8 +11,8 @@ use glam::Vec3;
 
 use super::frame::{orthogonalize, stable_tangent};
 use super::{
-    GBuffer, COVERAGE_CHANNEL, DEFAULT_VIEW, MAP_PREFIX, MASK_PREFIX, NORMAL_CHANNELS, OBJECT_ID_CHANNEL,
-    OBJECT_NAME_PREFIX, PLACEHOLDER_NORMAL, TANGENT_CHANNELS, VIEW_CHANNELS,
+    GBuffer, COLOR_MAP_CHANNELS, COVERAGE_CHANNEL, DEFAULT_VIEW, MAP_PREFIX, MASK_PREFIX, NORMAL_CHANNELS,
+    OBJECT_ID_CHANNEL, OBJECT_NAME_PREFIX, PLACEHOLDER_NORMAL, TANGENT_CHANNELS, VIEW_CHANNELS,
 };
 use crate::{Error, Result};
 
@@ -78,7 +78,20 @@ impl Checker<'_> {
             None => vec![0; normal.len()],
         };
         let masks = self.prefixed(&raw.channels, MASK_PREFIX)?;
-        let maps = self.prefixed(&raw.channels, MAP_PREFIX)?;
+        let mut maps = self.prefixed(&raw.channels, MAP_PREFIX)?;
+        // A map no look could name is left out, rather than offered and then refused.
+        maps.retain(|channel, _| {
+            let colour_map = channel.rsplit_once('.').filter(|(_, c)| COLOR_MAP_CHANNELS.contains(c));
+            let name = colour_map.map_or(channel.as_str(), |(name, _)| name);
+            match super::check_map_name(name) {
+                Ok(()) => true,
+                Err(problem) => {
+                    let path = self.path.display();
+                    self.warnings.push(format!("{path}: ignored channel {MAP_PREFIX}{channel}: {problem}"));
+                    false
+                }
+            }
+        });
         let object_names = self.object_names(&raw.object_name_attributes);
 
         let gbuffer = GBuffer {

@@ -528,12 +528,7 @@ fn unknown_param(name: &str, table: &str) -> String {
 /// A map's name as a binding gives it: `name` or `name.R|G|B`, without the `map.` prefix.
 fn map_name(key: &str, value: &toml::Value) -> Result<String, String> {
     let name = input::text(key, value)?;
-    if let Some(stripped) = name.strip_prefix(crate::gbuffer::MAP_PREFIX) {
-        return Err(format!("{key} = {name:?}: name the map without the channel prefix, as \"{stripped}\""));
-    }
-    if name.trim() != name {
-        return Err(format!("{key} = {name:?}: a map's name has no spaces around it"));
-    }
+    crate::gbuffer::check_map_name(&name).map_err(|problem| format!("{key} = {problem}"))?;
     Ok(name)
 }
 

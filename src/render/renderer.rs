@@ -61,12 +61,10 @@ struct FinalizePush {
     end_row: u32,
 }
 
-/// The per-object material inputs on the GPU: which stack each pixel uses, the layers, and the
-/// mask and map channels they read. Held only to keep them alive while the resolve set points at
-/// them.
+/// The per-object material inputs on the GPU: which stack each pixel uses and the layers. Held
+/// only to keep them alive while the resolve set points at them.
 struct GpuStacks {
     _stack_index: Image,
-    _channels: Image,
     _stacks: Buffer,
     _layers: Buffer,
     _set: DescriptorSet,
@@ -94,6 +92,9 @@ pub struct Renderer {
     /// The g-buffer's masks and maps by full channel name, for the stacks to choose from.
     channels: BTreeMap<String, Vec<f32>>,
     stacks: Option<GpuStacks>,
+    /// The mask and map channels the stacks read, one layer each, and their names: kept while
+    /// edits leave the list alone, so that changing a value uploads no channel again.
+    channel_layers: Option<(Vec<String>, Image)>,
     _environment: GpuEnvironment,
     environment_set: DescriptorSet,
     relight_set: DescriptorSet,
@@ -213,6 +214,7 @@ impl Renderer {
             object_ids: gbuffer.object_id.clone(),
             channels: layer_channels(gbuffer),
             stacks: None,
+            channel_layers: None,
             _environment: gpu_environment,
             environment_set,
             relight_set,
@@ -316,22 +318,26 @@ impl Renderer {
             self.object_ids.iter().map(|id| packed.stack_of_object.get(id).copied().unwrap_or(0)).collect();
         let stack_index = Image::new(ctx, vk::Format::R32_UINT, width, height, 1, false)?;
         stack_index.upload(ctx, bytemuck::cast_slice(&index))?;
-        // At least one channel layer, so the binding is always valid.
-        let layers = packed.channels.len().max(1) as u32;
-        let mut channel_data = vec![0.0f32; pixels * layers as usize];
-        for (i, name) in packed.channels.iter().enumerate() {
-            let values = self.channels.get(name).expect("pack() checked the masks and maps");
-            channel_data[i * pixels..(i + 1) * pixels].copy_from_slice(values);
+        if self.channel_layers.as_ref().is_none_or(|(names, _)| *names != packed.channels) {
+            // At least one channel layer, so the binding is always valid.
+            let layers = packed.channels.len().max(1) as u32;
+            let mut channel_data = vec![0.0f32; pixels * layers as usize];
+            for (i, name) in packed.channels.iter().enumerate() {
+                let values = self.channels.get(name).expect("pack() checked the masks and maps");
+                channel_data[i * pixels..(i + 1) * pixels].copy_from_slice(values);
+            }
+            let image = Image::new(ctx, vk::Format::R32_SFLOAT, width, height, layers, true)?;
+            image.upload(ctx, bytemuck::cast_slice(&channel_data))?;
+            self.channel_layers = Some((packed.channels.clone(), image));
         }
-        let channels = Image::new(ctx, vk::Format::R32_SFLOAT, width, height, layers, true)?;
-        channels.upload(ctx, bytemuck::cast_slice(&channel_data))?;
+        let (_, channels) = self.channel_layers.as_ref().expect("just made");
         let stacks = Buffer::with_data(ctx, bytemuck::cast_slice(&packed.stacks))?;
         let layer_buffer = Buffer::with_data(ctx, bytemuck::cast_slice(&packed.layers))?;
         let set = self.resolve.bind(
             0,
             &[
                 Binding::Image(&stack_index),
-                Binding::Image(&channels),
+                Binding::Image(channels),
                 Binding::Buffer(&stacks),
                 Binding::Buffer(&layer_buffer),
                 Binding::Image(&self.resolved),
@@ -339,13 +345,7 @@ impl Renderer {
         )?;
         let groups = [group_count(width, LOCAL_SIZE_X), group_count(height, LOCAL_SIZE_Y), 1];
         self.timed(|renderer, cmd| renderer.resolve.dispatch(cmd, &[&set], &[], groups))?;
-        self.stacks = Some(GpuStacks {
-            _stack_index: stack_index,
-            _channels: channels,
-            _stacks: stacks,
-            _layers: layer_buffer,
-            _set: set,
-        });
+        self.stacks = Some(GpuStacks { _stack_index: stack_index, _stacks: stacks, _layers: layer_buffer, _set: set });
         self.restart();
         Ok(())
     }

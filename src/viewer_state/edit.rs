@@ -250,10 +250,10 @@ impl State {
             Edit::SetMap { object, layer, param, map } => next.edit_stack(object, |stack| {
                 let layer = layer_mut(stack, object, layer)?;
                 match map {
-                    Some(map) if map.trim().is_empty() || map.trim() != map => {
-                        return Err(format!("{param}: a map's name must not be empty or have spaces around it"))
+                    Some(map) => {
+                        crate::gbuffer::check_map_name(&map).map_err(|problem| format!("{param}: {problem}"))?;
+                        layer.maps.insert(param, map)
                     }
-                    Some(map) => layer.maps.insert(param, map),
                     None => layer.maps.remove(&param),
                 };
                 Ok(())
