@@ -214,23 +214,23 @@ pub fn texel_size(format: vk::Format) -> u64 {
 impl Image {
     /// A storage image of `layers` layers (a 2D array view when `layers` > 1 or `array` is set).
     pub fn new(ctx: &Context, format: vk::Format, width: u32, height: u32, layers: u32, array: bool) -> Result<Image> {
-        Image::create(ctx, format, width, height, layers, array, Purpose::Storage)
+        Image::create(ctx, format, width, height, layers, array, Purpose::Storage, 1)
     }
 
     /// An RGBA8 storage image holding sRGB-encoded display pixels, which can also be sampled
     /// through [`Image::srgb_view`] (the viewer shows it that way).
     pub fn display(ctx: &Context, width: u32, height: u32) -> Result<Image> {
-        Image::create(ctx, vk::Format::R8G8B8A8_UNORM, width, height, 1, false, Purpose::Display)
+        Image::create(ctx, vk::Format::R8G8B8A8_UNORM, width, height, 1, false, Purpose::Display, 1)
     }
 
     /// A colour render target whose pixels transfers can read back.
     pub fn color_target(ctx: &Context, format: vk::Format, width: u32, height: u32) -> Result<Image> {
-        Image::create(ctx, format, width, height, 1, false, Purpose::ColorTarget)
+        Image::create(ctx, format, width, height, 1, false, Purpose::ColorTarget, 1)
     }
 
     /// A 32-bit float depth buffer.
     pub fn depth_target(ctx: &Context, width: u32, height: u32) -> Result<Image> {
-        Image::create(ctx, vk::Format::D32_SFLOAT, width, height, 1, false, Purpose::DepthTarget)
+        Image::create(ctx, vk::Format::D32_SFLOAT, width, height, 1, false, Purpose::DepthTarget, 1)
     }
 
     /// A sampled RGBA8 texture holding `levels`, its mip chain from the full size down, each
@@ -239,7 +239,7 @@ impl Image {
     pub fn texture(ctx: &Context, levels: &[image::RgbaImage], srgb: bool) -> Result<Image> {
         let format = if srgb { vk::Format::R8G8B8A8_SRGB } else { vk::Format::R8G8B8A8_UNORM };
         let (width, height) = levels[0].dimensions();
-        let image = Image::create_levels(ctx, format, width, height, 1, false, Purpose::Texture, levels.len() as u32)?;
+        let image = Image::create(ctx, format, width, height, 1, false, Purpose::Texture, levels.len() as u32)?;
         let total: usize = levels.iter().map(|l| l.as_raw().len()).sum();
         let mut staging = Buffer::staging(ctx, total as u64)?;
         let mut regions = Vec::with_capacity(levels.len());
@@ -264,20 +264,9 @@ impl Image {
         Ok(image)
     }
 
-    fn create(
-        ctx: &Context,
-        format: vk::Format,
-        width: u32,
-        height: u32,
-        layers: u32,
-        array: bool,
-        purpose: Purpose,
-    ) -> Result<Image> {
-        Image::create_levels(ctx, format, width, height, layers, array, purpose, 1)
-    }
-
+    /// An image of `levels` mip levels (1 for all but textures).
     #[allow(clippy::too_many_arguments)]
-    fn create_levels(
+    fn create(
         ctx: &Context,
         format: vk::Format,
         width: u32,
