@@ -12,6 +12,7 @@ pub mod environment;
 pub mod error;
 pub mod gbuffer;
 pub mod gpu;
+pub mod input;
 pub mod lab;
 pub mod material;
 pub mod render;
@@ -20,9 +21,9 @@ pub mod shading;
 pub mod viewer;
 pub mod viewer_state;
 
-pub use error::{Error, ErrorKind, Result};
+pub use error::{printable, Error, ErrorKind, Result};
 
 /// Prints a non-fatal warning to stderr, in the same one-line style as errors.
 pub fn warn(message: impl std::fmt::Display) {
-    eprintln!("lookdev: warning: {message}");
+    eprintln!("lookdev: warning: {}", printable(&message.to_string()));
 }

@@ -342,7 +342,7 @@ fn a_folder_is_not_a_file() {
     let path = scratch("a-folder.exr");
     let _ = std::fs::remove_dir(&path);
     std::fs::create_dir(&path).unwrap();
-    read_err(&path, &["not a file"]);
+    read_err(&path, &["not a regular file (a folder)"]);
 }
 
 #[test]

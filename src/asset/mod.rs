@@ -15,9 +15,11 @@ pub mod import;
 pub mod materials;
 mod names;
 pub mod textures;
+pub mod validate;
 
 pub use names::channel_name;
 
+use crate::input::{self, Kind};
 use crate::{Error, Result};
 use base64::Engine;
 use gltf::json::Value;
@@ -46,6 +48,9 @@ const COMPRESSION: [(&str, &str); 3] = [
     ("KHR_meshopt_compression", "meshopt compression"),
 ];
 
+/// The largest texture side lookdev decodes: the GPU's image limit on lavapipe and most devices.
+const MAX_TEXTURE_SIDE: u32 = 16384;
+
 /// Whether loading an asset decodes its textures' images or only checks them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Texels {
@@ -73,12 +78,21 @@ impl Asset {
     /// Reads an asset; with [`Texels::Check`], the images its materials use are read and their
     /// format recognised but not decoded (what the import needs: it reads no texel).
     pub fn load_with(path: &Path, texels: Texels) -> Result<Asset> {
-        let bytes = std::fs::read(path).map_err(|e| Error::input_file(path, format!("cannot read ({e})")))?;
-        let gltf = gltf::Gltf::from_slice_without_validation(&bytes)
+        Asset::from_bytes(&input::read(path, Kind::Gltf)?, path, texels)
+    }
+
+    /// Reads an asset from the bytes of its `.gltf` or `.glb` file; `path` names it in messages,
+    /// and its folder is where external buffers and images are looked for.
+    pub fn from_bytes(bytes: &[u8], path: &Path, texels: Texels) -> Result<Asset> {
+        let gltf = gltf::Gltf::from_slice_without_validation(bytes)
             .map_err(|e| Error::input_file(path, format!("not a readable glTF file ({e})")))?;
         let blob = gltf.blob;
         check_texture_formats(path, gltf.document.as_json())?;
         check_required_extensions(path, &gltf.document)?;
+        let warnings = validate::check(gltf.document.as_json()).map_err(|problem| Error::input_file(path, problem))?;
+        for warning in warnings {
+            crate::warn(format!("{}: {warning}", path.display()));
+        }
         // Required extensions are checked above; everything else is validated as usual.
         let mut json = gltf.document.into_json();
         json.extensions_required.clear();
@@ -187,8 +201,8 @@ impl Asset {
                 .map_err(|e| Error::input_file(&self.path, format!("{label} cannot be decoded ({e})")))?;
             return Ok(None);
         }
-        let decoded = image::load_from_memory(&bytes)
-            .map_err(|e| Error::input_file(&self.path, format!("{label} cannot be decoded ({e})")))?;
+        let decoded = input::image::decode(&bytes, MAX_TEXTURE_SIDE)
+            .map_err(|problem| Error::input_file(&self.path, format!("{label} {problem}")))?;
         Ok(Some(decoded.into_rgba8()))
     }
 
@@ -329,7 +343,8 @@ fn read_uri(path: &Path, folder: &Path, uri: &str, label: &str) -> Result<Vec<u8
         return Err(Error::input_file(path, format!("{label}: '{uri}' is not a local file")));
     }
     let file = folder.join(percent_decode(uri));
-    std::fs::read(&file).map_err(|e| Error::input_file(path, format!("{label}: cannot read {} ({e})", file.display())))
+    input::read_bytes(&file, Kind::GltfResource)
+        .map_err(|problem| Error::input_file(path, format!("{label}: cannot read {}: {problem}", file.display())))
 }
 
 /// URIs escape spaces and other characters as %XX.

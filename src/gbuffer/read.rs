@@ -6,7 +6,9 @@ use std::path::Path;
 use exr::prelude::{AttributeValue, FlatSamples, ReadChannels, ReadLayers, Text};
 
 use super::validate::{self, RawImage};
-use super::{GBuffer, OBJECT_NAME_PREFIX};
+use super::{GBuffer, MASK_NAME_PREFIX, OBJECT_NAME_PREFIX};
+use crate::input::exr::Budget;
+use crate::input::{self, Kind};
 use crate::{Error, Result};
 
 impl GBuffer {
@@ -23,21 +25,31 @@ impl GBuffer {
     /// Like [`GBuffer::read`], but returns the warnings (one line each, naming the file) instead
     /// of printing them, for callers that show them elsewhere.
     pub fn read_with_warnings(path: &Path) -> Result<(GBuffer, Vec<String>)> {
-        let raw = read_exr(path)?;
+        GBuffer::decode(&input::read(path, Kind::GBuffer)?, path)
+    }
+
+    /// Decodes and validates the bytes of a g-buffer file; `path` names it in messages. Needs
+    /// no GPU and touches no file.
+    pub fn decode(bytes: &[u8], path: &Path) -> Result<(GBuffer, Vec<String>)> {
+        let raw = decode_exr(bytes, path)?;
         validate::build(path, raw)
     }
 }
 
+/// The most a g-buffer's channels may take decoded: a 4K frame with forty float channels.
+const MAX_DECODED_BYTES: u64 = 4 << 30;
+
 /// Decodes the single part of an EXR file into named channels, without judging their contents.
-fn read_exr(path: &Path) -> Result<RawImage> {
-    check_is_file(path)?;
+fn decode_exr(bytes: &[u8], path: &Path) -> Result<RawImage> {
+    let budget = Budget { max_side: input::exr::MAX_SIDE, max_decoded_bytes: MAX_DECODED_BYTES };
+    input::exr::check(bytes, &budget).map_err(|problem| Error::input_file(path, problem))?;
     let image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
         .all_channels()
         .all_layers()
         .all_attributes()
-        .from_file(path)
+        .from_buffered(std::io::Cursor::new(bytes))
         .map_err(|e| Error::input_file(path, format!("not a readable OpenEXR file ({e})")))?;
 
     let part_count = image.layer_data.len();
@@ -57,25 +69,21 @@ fn read_exr(path: &Path) -> Result<RawImage> {
         .collect();
 
     // Unknown attributes may land in either set, depending on their type.
-    let attributes = layer.attributes.other.iter().chain(image.attributes.other.iter());
-    let object_name_attributes = attributes
-        .filter_map(|(name, value)| {
-            let name = text_to_string(name);
-            name.starts_with(OBJECT_NAME_PREFIX).then(|| (name, attribute_text(value)))
-        })
+    let attributes: Vec<(String, Option<String>)> = layer
+        .attributes
+        .other
+        .iter()
+        .chain(image.attributes.other.iter())
+        .map(|(name, value)| (text_to_string(name), attribute_text(value)))
+        .collect();
+    let object_name_attributes =
+        attributes.iter().filter(|(name, _)| name.starts_with(OBJECT_NAME_PREFIX)).cloned().collect();
+    let mask_names = attributes
+        .into_iter()
+        .filter_map(|(name, value)| Some((name.strip_prefix(MASK_NAME_PREFIX)?.to_string(), value?)))
         .collect();
 
-    Ok(RawImage { width: layer.size.0, height: layer.size.1, channels, object_name_attributes })
-}
-
-/// A clear error for a path that is not there or not a file, before the EXR decoder words it.
-fn check_is_file(path: &Path) -> Result<()> {
-    match std::fs::metadata(path) {
-        Ok(meta) if meta.is_file() => Ok(()),
-        Ok(_) => Err(Error::input_file(path, "not a file")),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(Error::input_file(path, "file not found")),
-        Err(e) => Err(Error::input_file(path, format!("cannot open the file ({e})"))),
-    }
+    Ok(RawImage { width: layer.size.0, height: layer.size.1, channels, object_name_attributes, mask_names })
 }
 
 /// The value of a text attribute, or `None` for any other type.

@@ -193,6 +193,11 @@ pub(crate) fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a s
 /// "mask".
 pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
     let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+    // A name this long is no typo of a short one; the table would be as large as the product.
+    const LONGEST: usize = 128;
+    if a.len() > LONGEST || b.len() > LONGEST {
+        return a.len().max(b.len());
+    }
     // d[i][j] is the distance between the first i characters of a and the first j of b.
     let mut d = vec![vec![0usize; b.len() + 1]; a.len() + 1];
     for (i, row) in d.iter_mut().enumerate() {
@@ -212,12 +217,9 @@ pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
     d[a.len()][b.len()]
 }
 
-/// Reads a whole file, saying plainly when it is missing.
+/// Reads a whole look or preset file, through the checked open of [`crate::input`].
 pub(crate) fn read_text(path: &Path) -> crate::Result<String> {
-    std::fs::read_to_string(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => Error::input_file(path, "file not found"),
-        _ => Error::input_file(path, format!("cannot read: {e}")),
-    })
+    crate::input::read_text(path, crate::input::Kind::Toml)
 }
 
 // ---- Value conversions. Each names the key in its message; the caller adds FILE:LINE. ----

@@ -64,7 +64,7 @@ const COMMANDS: &str = "select, set, reset, map, add, remove, duplicate, move, s
 
 impl Script {
     pub fn load(path: &Path) -> Result<Script> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::input_file(path, format!("cannot read ({e})")))?;
+        let text = crate::input::read_text(path, crate::input::Kind::Script)?;
         Script::parse(&text, path)
     }
 
@@ -213,8 +213,7 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
         }
         "tonemap" => {
             arity(1)?;
-            let tonemap = Tonemap::from_name(args[0])
-                .ok_or_else(|| format!("unknown tone map '{}' (expected linear, neutral, aces, agx)", args[0]))?;
+            let tonemap = Tonemap::parse(args[0])?;
             edit(Edit::SetTonemap(tonemap))
         }
         "spp" => {

@@ -1,0 +1,183 @@
+//! OpenEXR headers, checked before any pixel is decoded.
+//!
+//! The decoder sizes its pixel buffers from the header's data window and channel list, so a
+//! file of a few KiB can claim 100000×100000 pixels and have the allocation abort the process.
+//! [`check`] reads only the header and refuses, before anything is allocated for pixels:
+//!
+//! - deep data, and images or tiles wider or taller than [`Budget::max_side`];
+//! - pixel data larger than [`Budget::max_decoded_bytes`];
+//! - pixel data that the file cannot hold: more than its size times the best ratio its
+//!   compression can reach ([`max_ratio`]), or more chunks than the file has room for.
+
+use exr::compression::Compression;
+use exr::meta::attribute::{LevelMode, SampleType};
+use exr::meta::{BlockDescription, MetaData};
+
+/// Limits for one kind of image.
+#[derive(Clone, Copy, Debug)]
+pub struct Budget {
+    /// The largest width or height. The GPU's own limit is checked again once the device is
+    /// known; this bounds the arithmetic and the allocations before that.
+    pub max_side: usize,
+    /// The most bytes the decoded pixels of the channels read may take.
+    pub max_decoded_bytes: u64,
+}
+
+/// The largest image side any Vulkan device lookdev runs on accepts (lavapipe and most GPUs
+/// take 16384, some 32768).
+pub const MAX_SIDE: usize = 32768;
+
+/// The smallest a chunk can be: its offset-table entry, its y or tile coordinates, and its
+/// data size.
+const MIN_CHUNK_BYTES: u64 = 8 + 4 + 4;
+
+/// What the header of an accepted file declares.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Declared {
+    pub width: usize,
+    pub height: usize,
+    pub parts: usize,
+    pub decoded_bytes: u64,
+}
+
+/// Checks the header of the OpenEXR file `bytes` against `budget` and against the file's own
+/// size. Returns the problem, for the caller to prefix with the file's name.
+pub fn check(bytes: &[u8], budget: &Budget) -> Result<Declared, String> {
+    let meta = MetaData::read_from_buffered(bytes, false).map_err(|e| unreadable(&e))?;
+    MetaData::validate(&meta.headers, false).map_err(|e| unreadable(&e))?;
+    let file_bytes = bytes.len() as u64;
+    let mut declared = Declared { width: 0, height: 0, parts: meta.headers.len(), decoded_bytes: 0 };
+    let mut stored_bytes: u64 = 0;
+    let mut chunks: u64 = 0;
+    for header in &meta.headers {
+        if header.deep {
+            return Err("deep data is not supported".into());
+        }
+        let (width, height) = (header.layer_size.width(), header.layer_size.height());
+        if width > budget.max_side || height > budget.max_side {
+            return Err(format!(
+                "the header declares {width}x{height} pixels, larger than the {} pixels a side lookdev accepts",
+                budget.max_side
+            ));
+        }
+        if let BlockDescription::Tiles(tiles) = header.blocks {
+            let (tile_w, tile_h) = (tiles.tile_size.width(), tiles.tile_size.height());
+            if tile_w == 0 || tile_h == 0 || tile_w > budget.max_side || tile_h > budget.max_side {
+                return Err(format!("the header declares {tile_w}x{tile_h} tiles"));
+            }
+        }
+        // Sides are bounded above, so none of these products can overflow.
+        let bytes_per_pixel: u64 = header.channels.list.iter().map(|c| sample_bytes(c.sample_type)).sum();
+        let largest_level = width as u64 * height as u64 * bytes_per_pixel;
+        declared.width = declared.width.max(width);
+        declared.height = declared.height.max(height);
+        declared.decoded_bytes += largest_level;
+        let all_levels = match header.blocks {
+            BlockDescription::Tiles(tiles) if tiles.level_mode != LevelMode::Singular => {
+                // Mip and rip levels at most double, respectively quadruple, the largest one.
+                largest_level * if tiles.level_mode == LevelMode::MipMap { 2 } else { 4 }
+            }
+            _ => largest_level,
+        };
+        stored_bytes += all_levels.div_ceil(max_ratio(header.compression));
+        chunks += header.chunk_count as u64;
+    }
+    if declared.decoded_bytes > budget.max_decoded_bytes {
+        return Err(format!(
+            "the header declares {} of pixel data ({}x{}), more than the {} lookdev decodes for one image",
+            super::size_text(declared.decoded_bytes),
+            declared.width,
+            declared.height,
+            super::size_text(budget.max_decoded_bytes)
+        ));
+    }
+    if stored_bytes > file_bytes || chunks.saturating_mul(MIN_CHUNK_BYTES) > file_bytes {
+        return Err(format!(
+            "the header declares {} of pixel data ({}x{}) in {chunks} chunks, more than a file of {} can hold: \
+             the file is truncated or its header is damaged",
+            super::size_text(declared.decoded_bytes),
+            declared.width,
+            declared.height,
+            super::size_text(file_bytes)
+        ));
+    }
+    Ok(declared)
+}
+
+/// An upper bound on decoded bytes per stored byte for a compression: 1 for none, 64 for RLE
+/// (a run of 128 bytes in 2), about 1032 for the zlib-based methods and PIZ's Huffman coder with
+/// run-length codes, 11 for B44 (a flat 4×4 block of halves in 3 bytes). DWA and HTJ2K can in
+/// principle reach more on constant images; 2048 is far beyond what real images reach (a
+/// constant 4096×2048 image compresses about 135:1 with DWAB, real environments about 30:1).
+pub fn max_ratio(compression: Compression) -> u64 {
+    match compression {
+        Compression::Uncompressed => 1,
+        Compression::RLE => 64,
+        Compression::B44 | Compression::B44A => 11,
+        Compression::ZIP1 | Compression::ZIP16 | Compression::PIZ => 1100,
+        // 32-bit floats are cut to 24 bits before zlib.
+        Compression::PXR24 => 1500,
+        Compression::DWAA(_) | Compression::DWAB(_) | Compression::HTJ2K32 | Compression::HTJ2K256 => 2048,
+    }
+}
+
+fn sample_bytes(sample: SampleType) -> u64 {
+    sample.bytes_per_sample() as u64
+}
+
+fn unreadable(e: &exr::error::Error) -> String {
+    format!("not a readable OpenEXR file ({e})")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A minimal uncompressed scan-line file of `width`×`height` half RGB, with `data_bytes`
+    /// of pixel data after the header (a real file has 6·width·height plus the chunk headers).
+    fn file(width: i32, height: i32, data_bytes: usize) -> Vec<u8> {
+        fn attribute(name: &str, kind: &str, data: &[u8]) -> Vec<u8> {
+            let mut out = [name.as_bytes(), b"\0", kind.as_bytes(), b"\0"].concat();
+            out.extend((data.len() as i32).to_le_bytes());
+            out.extend(data);
+            out
+        }
+        let window: Vec<u8> = [0, 0, width - 1, height - 1].iter().flat_map(|v: &i32| v.to_le_bytes()).collect();
+        let mut channels = Vec::new();
+        for name in ["B", "G", "R"] {
+            channels.extend(name.as_bytes());
+            channels.extend([0, 1, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0]);
+        }
+        channels.push(0);
+        let mut bytes = vec![0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0];
+        bytes.extend(attribute("channels", "chlist", &channels));
+        bytes.extend(attribute("compression", "compression", &[0]));
+        bytes.extend(attribute("dataWindow", "box2i", &window));
+        bytes.extend(attribute("displayWindow", "box2i", &window));
+        bytes.extend(attribute("lineOrder", "lineOrder", &[0]));
+        bytes.extend(attribute("pixelAspectRatio", "float", &1f32.to_le_bytes()));
+        bytes.extend(attribute("screenWindowCenter", "v2f", &[0; 8]));
+        bytes.extend(attribute("screenWindowWidth", "float", &1f32.to_le_bytes()));
+        bytes.push(0);
+        bytes.resize(bytes.len() + data_bytes, 0);
+        bytes
+    }
+
+    const BUDGET: Budget = Budget { max_side: MAX_SIDE, max_decoded_bytes: 1 << 30 };
+
+    #[test]
+    fn a_header_that_fits_its_file_is_accepted() {
+        let declared = check(&file(64, 32, 64 * 32 * 6 + 32 * 16), &BUDGET).unwrap();
+        assert_eq!((declared.width, declared.height, declared.decoded_bytes), (64, 32, 64 * 32 * 6));
+    }
+
+    #[test]
+    fn headers_claiming_more_than_the_file_holds_are_refused() {
+        let message = check(&file(100_000, 100_000, 7000), &BUDGET).unwrap_err();
+        assert!(message.contains("100000x100000 pixels, larger than the 32768"), "{message}");
+        let message = check(&file(20_000, 20_000, 7000), &BUDGET).unwrap_err();
+        assert!(message.contains("more than the 1.0 GiB lookdev decodes"), "{message}");
+        let message = check(&file(4000, 4000, 7000), &BUDGET).unwrap_err();
+        assert!(message.contains("more than a file of 7."), "{message}");
+    }
+}
