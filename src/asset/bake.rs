@@ -666,7 +666,8 @@ impl Accumulator {
             let hits = self.hits[p];
             let (x, y) = ((p as u32 % width) as f32 + 0.5, (p as u32 / width) as f32 + 0.5);
             // Background and edges: the view vector of the ray through the pixel's centre.
-            let toward = -camera.ray(x, y, width, height);
+            // At scales beyond 32-bit floats the ray is lost; the camera's axis keeps V a unit vector.
+            let toward = (-camera.ray(x, y, width, height)).try_normalize().unwrap_or(-camera.forward);
             let n = if hits > 0 { self.normal[p].normalize_or_zero() } else { Vec3::ZERO };
             let (n, v) =
                 if n == Vec3::ZERO { (toward, toward) } else { (n, self.view[p].try_normalize().unwrap_or(toward)) };
@@ -716,6 +717,8 @@ impl Accumulator {
             }
         }
         let object_names = geometry.draws.iter().map(|d| (d.object_id, d.name.clone())).collect();
+        let mask_names =
+            used.iter().filter(|m| m.label != m.channel).map(|m| (m.channel.clone(), m.label.clone())).collect();
         GBuffer {
             width,
             height,
@@ -727,6 +730,7 @@ impl Accumulator {
             masks,
             maps,
             object_names,
+            mask_names,
             has_view: true,
             has_tangent: true,
         }

@@ -103,6 +103,12 @@ pub fn run(args: BakeArgs) -> Result<()> {
     };
     drop(ctx);
     super::check_validation(&counter)?;
+    if gbuffer.coverage.iter().all(|&a| a == 0.0) {
+        crate::warn(format!(
+            "{}: the camera sees none of the asset, so no pixel of the g-buffer is covered (check the asset's scale and the camera)",
+            args.model.display()
+        ));
+    }
     gbuffer.write(&args.out)?;
     if !args.quiet {
         eprintln!(

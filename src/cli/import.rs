@@ -43,7 +43,10 @@ pub fn run(args: ImportArgs) -> Result<()> {
             } else {
                 format!(": {}", material.mapped.notes.join("; "))
             };
-            eprintln!("lookdev: '{}' -> preset {}{notes}", material.used.label, material.preset.name);
+            eprintln!(
+                "lookdev: {}",
+                crate::printable(&format!("'{}' -> preset {}{notes}", material.used.label, material.preset.name))
+            );
         }
         eprintln!("lookdev: wrote {} files, the look {}", written.len(), args.look.display());
     }

@@ -94,6 +94,9 @@ pub const MAP_PREFIX: &str = "map.";
 pub const COLOR_MAP_CHANNELS: [&str; 3] = ["R", "G", "B"];
 /// An object's name is stored in the header attribute with this prefix followed by its ID.
 pub const OBJECT_NAME_PREFIX: &str = "objectName.";
+/// The full name behind a mask whose channel name had to be shortened or made safe is stored
+/// in the header attribute with this prefix followed by the mask's name.
+pub const MASK_NAME_PREFIX: &str = "maskName.";
 
 /// The view vector of a file without `V.*`: an orthographic camera looking down −Z.
 pub const DEFAULT_VIEW: [f32; 3] = [0.0, 0.0, 1.0];
@@ -129,6 +132,9 @@ pub struct GBuffer {
     pub maps: BTreeMap<String, Vec<f32>>,
     /// Object names by ID, from the `objectName.<ID>` header attributes.
     pub object_names: BTreeMap<u32, String>,
+    /// The full names of masks whose channel names were shortened or made safe (a material's
+    /// name as the asset gives it), by mask name, from the `maskName.<mask>` header attributes.
+    pub mask_names: BTreeMap<String, String>,
     /// Whether the file carried `V.*`.
     pub has_view: bool,
     /// Whether the file carried `T.*`.

@@ -61,6 +61,7 @@ impl GBuffer {
             masks,
             maps: BTreeMap::new(),
             object_names: BTreeMap::from([(BALL_ID, BALL_NAME.to_string()), (PEDESTAL_ID, PEDESTAL_NAME.to_string())]),
+            mask_names: BTreeMap::new(),
             has_view: true,
             has_tangent: true,
         }

@@ -24,6 +24,8 @@ pub(crate) struct RawImage {
     pub channels: BTreeMap<String, FlatSamples>,
     /// Header attributes named `objectName.*`, with their value where it is text.
     pub object_name_attributes: Vec<(String, Option<String>)>,
+    /// Header text attributes named `maskName.<mask>`, by mask name.
+    pub mask_names: BTreeMap<String, String>,
 }
 
 /// A normal shorter than this is "clearly empty": it marks background in files without `A`, and
@@ -105,6 +107,7 @@ impl Checker<'_> {
             masks,
             maps,
             object_names,
+            mask_names: raw.mask_names,
             has_view: raw_view.is_some(),
             has_tangent: raw_tangent.is_some(),
         };
@@ -471,6 +474,7 @@ mod tests {
             height,
             channels: channels.into_iter().map(|(name, samples)| (name.to_string(), samples)).collect(),
             object_name_attributes: Vec::new(),
+            mask_names: BTreeMap::new(),
         }
     }
 

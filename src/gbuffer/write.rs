@@ -9,8 +9,8 @@ use exr::prelude::{
 use half::f16;
 
 use super::{
-    GBuffer, COVERAGE_CHANNEL, MAP_PREFIX, MASK_PREFIX, NORMAL_CHANNELS, OBJECT_ID_CHANNEL, OBJECT_NAME_PREFIX,
-    TANGENT_CHANNELS, VIEW_CHANNELS,
+    GBuffer, COVERAGE_CHANNEL, MAP_PREFIX, MASK_NAME_PREFIX, MASK_PREFIX, NORMAL_CHANNELS, OBJECT_ID_CHANNEL,
+    OBJECT_NAME_PREFIX, TANGENT_CHANNELS, VIEW_CHANNELS,
 };
 use crate::{Error, Result};
 
@@ -79,6 +79,9 @@ impl GBuffer {
         let mut attributes = LayerAttributes { software_name: Some(text("lookdev")), ..LayerAttributes::default() };
         for (id, name) in &self.object_names {
             attributes.other.insert(text(&format!("{OBJECT_NAME_PREFIX}{id}")), AttributeValue::Text(text(name)));
+        }
+        for (mask, name) in &self.mask_names {
+            attributes.other.insert(text(&format!("{MASK_NAME_PREFIX}{mask}")), AttributeValue::Text(text(name)));
         }
 
         let encoding =

@@ -30,6 +30,7 @@ pub fn sphere(size: u32) -> GBuffer {
         masks: BTreeMap::new(),
         maps: BTreeMap::new(),
         object_names: BTreeMap::from([(1, "sphere".to_string())]),
+        mask_names: BTreeMap::new(),
         has_view: false,
         has_tangent: false,
     };
