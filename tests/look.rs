@@ -115,7 +115,10 @@ fn parameter_values_are_checked_for_range_finiteness_and_kind() {
 
 #[test]
 fn environment_and_render_values_are_checked() {
-    assert_eq!(error("[environment]\nintensity = -1\n"), "looks/shot.toml:2: intensity = -1 must be ≥ 0");
+    assert_eq!(
+        error("[environment]\nintensity = -1\n"),
+        "looks/shot.toml:2: intensity = -1 must be a number from 0 to 1e6"
+    );
     assert_eq!(error("[environment]\nintensity = inf\n"), "looks/shot.toml:2: intensity = inf is not a finite number");
     assert_eq!(error("[environment]\nrotation = nan\n"), "looks/shot.toml:2: rotation = NaN is not a finite number");
     assert_eq!(
@@ -134,11 +137,11 @@ fn environment_and_render_values_are_checked() {
     );
     assert_eq!(
         error("[render]\ntonemap = \"filmic\"\n"),
-        "looks/shot.toml:2: unknown tonemap 'filmic' (expected linear, neutral, aces, agx)"
+        "looks/shot.toml:2: unknown tone map 'filmic' (expected linear, neutral, aces, agx)"
     );
     assert_eq!(
         error("[render]\ntonemap = \"agz\"\n"),
-        "looks/shot.toml:2: unknown tonemap 'agz' (expected linear, neutral, aces, agx); did you mean 'agx'?"
+        "looks/shot.toml:2: unknown tone map 'agz' (expected linear, neutral, aces, agx); did you mean 'agx'?"
     );
 }
 

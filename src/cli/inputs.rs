@@ -59,12 +59,8 @@ pub struct DisplayArgs {
     #[arg(long, value_name = "EV", allow_hyphen_values = true)]
     pub exposure: Option<f32>,
     /// PNG tone map: linear, neutral (Khronos PBR Neutral), aces or agx.
-    #[arg(long, value_name = "NAME", value_parser = parse_tonemap)]
+    #[arg(long, value_name = "NAME", value_parser = Tonemap::parse)]
     pub tonemap: Option<Tonemap>,
-}
-
-fn parse_tonemap(name: &str) -> std::result::Result<Tonemap, String> {
-    Tonemap::from_name(name).ok_or_else(|| format!("unknown tone map '{name}' (expected linear, neutral, aces, agx)"))
 }
 
 /// The command-line overrides of a look's settings.
@@ -103,5 +99,10 @@ pub fn ball_inputs(
         Some(path) => environment::load::load(path, &lighting.load_options())?,
         None => Environment::studio(),
     };
-    Ok((settings, environment, GBuffer::shaderball(size, size)))
+    let gbuffer = GBuffer::shaderball(size, size);
+    let name = std::path::Path::new("built-in shader ball");
+    crate::render::scene::dark_render_warnings(&gbuffer, name, &environment, settings.lighting.intensity)
+        .into_iter()
+        .for_each(crate::warn);
+    Ok((settings, environment, gbuffer))
 }

@@ -99,7 +99,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let counter = ctx.validation_counter();
     let device_name = ctx.info().name.clone();
     let settings = &scene.settings;
-    let rendered = render(&ctx, &scene, format == OutputFormat::Exr, "rendering", args.quiet)?;
+    let rendered = render(&ctx, &scene, true, "rendering", args.quiet)?;
     drop(ctx);
     super::check_validation(&counter)?;
     write(&args.out, format, &rendered, settings.lighting.background)?;
@@ -120,7 +120,11 @@ fn write(path: &Path, format: OutputFormat, rendered: &Rendered, background: boo
     let (width, height) = (rendered.width, rendered.height);
     match (format, &rendered.radiance) {
         (OutputFormat::Exr, Some(radiance)) => output::write_exr(path, width, height, radiance, background),
-        _ => output::write_png(path, width, height, &rendered.display, !background),
+        (_, radiance) => {
+            // The display pixels are 8-bit; the radiance behind them shows whether any is not finite.
+            radiance.as_deref().map_or(Ok(()), |radiance| output::check_finite(path, radiance))?;
+            output::write_png(path, width, height, &rendered.display, !background)
+        }
     }
 }
 

@@ -119,6 +119,7 @@ pub fn run(args: TurntableArgs) -> Result<()> {
                     output::write_exr(&path, width, height, &batch.radiance()?, settings.lighting.background)?
                 }
                 OutputFormat::Png => {
+                    output::check_finite(&path, &batch.radiance()?)?;
                     output::write_png(&path, width, height, &batch.display(&settings)?, !settings.lighting.background)?
                 }
             }

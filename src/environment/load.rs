@@ -1,6 +1,9 @@
 //! Reading `.exr` and `.hdr` environments, with the checks of docs/formats.md.
 
 use super::Environment;
+use super::MAX_TEXEL;
+use crate::input::exr::Budget;
+use crate::input::{self, Kind};
 use crate::{Error, Result};
 use std::path::Path;
 
@@ -9,8 +12,8 @@ use std::path::Path;
 pub struct LoadOptions {
     /// Accept a map that is not 2:1 (it is still read as equirectangular).
     pub any_aspect: bool,
-    /// Replace NaN and negative texels with 0 and +Inf with the largest finite value, instead
-    /// of refusing the file.
+    /// Replace NaN and negative texels with 0, +Inf with the largest valid value, and texels
+    /// brighter than [`MAX_TEXEL`] with it, instead of refusing the file.
     pub clamp_invalid: bool,
 }
 
@@ -19,19 +22,18 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Environment> {
     let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     let name = path.display().to_string();
     match extension.as_deref() {
-        Some("exr") => {
-            let bytes = std::fs::read(path)
-                .map_err(|e| Error::input_file(path, format!("cannot read the environment: {e}")))?;
-            from_exr_bytes(&bytes, &name, options)
-        }
-        Some("hdr") => {
-            let bytes = std::fs::read(path)
-                .map_err(|e| Error::input_file(path, format!("cannot read the environment: {e}")))?;
-            from_hdr_bytes(&bytes, &name, options)
-        }
+        Some("exr") => from_exr_bytes(&input::read(path, Kind::Environment)?, &name, options),
+        Some("hdr") => from_hdr_bytes(&input::read(path, Kind::Environment)?, &name, options),
         _ => Err(Error::input_file(path, "unsupported environment format: use an equirectangular .exr or .hdr")),
     }
 }
+
+/// The most an environment's pixels may take decoded: 16384×8192 RGB in half floats, with room
+/// for an alpha channel.
+const MAX_DECODED_BYTES: u64 = 2 << 30;
+
+/// The size limits of an environment image, before decoding.
+const BUDGET: Budget = Budget { max_side: input::exr::MAX_SIDE, max_decoded_bytes: MAX_DECODED_BYTES };
 
 pub fn from_exr_bytes(bytes: &[u8], name: &str, options: &LoadOptions) -> Result<Environment> {
     let (width, height, texels) = read_exr_texels(bytes, name)?;
@@ -41,6 +43,7 @@ pub fn from_exr_bytes(bytes: &[u8], name: &str, options: &LoadOptions) -> Result
 /// The RGB texels of an EXR (a Y-only file is read as grey), before any checks.
 pub fn read_exr_texels(bytes: &[u8], name: &str) -> Result<(u32, u32, Vec<[f32; 3]>)> {
     use exr::prelude::{read, ReadChannels, ReadLayers};
+    input::exr::check(bytes, &BUDGET).map_err(|problem| Error::input_file(name, problem))?;
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
@@ -93,12 +96,34 @@ pub fn read_exr_texels(bytes: &[u8], name: &str) -> Result<(u32, u32, Vec<[f32; 
 }
 
 pub fn from_hdr_bytes(bytes: &[u8], name: &str, options: &LoadOptions) -> Result<Environment> {
-    let decoded = image::load_from_memory_with_format(bytes, image::ImageFormat::Hdr)
-        .map_err(|e| Error::input_file(name, format!("not a readable Radiance .hdr file ({e})")))?
-        .into_rgb32f();
+    let unreadable = |e: image::ImageError| Error::input_file(name, format!("not a readable Radiance .hdr file ({e})"));
+    let decoder = image::codecs::hdr::HdrDecoder::new(bytes).map_err(unreadable)?;
+    check_hdr_size(image::ImageDecoder::dimensions(&decoder), bytes.len() as u64)
+        .map_err(|problem| Error::input_file(name, problem))?;
+    let decoded = image::DynamicImage::from_decoder(decoder).map_err(unreadable)?.into_rgb32f();
     let (width, height) = decoded.dimensions();
     let texels = decoded.pixels().map(|p| p.0).collect();
     validate(width, height, texels, name, options)
+}
+
+/// Refuses a Radiance header whose size the file cannot hold, before the decoder allocates it.
+/// Run-length encoded scan lines store at most 127 equal bytes in 2, so each 4-byte texel takes
+/// at least 4·2/127 bytes of the file.
+fn check_hdr_size((width, height): (u32, u32), file_bytes: u64) -> std::result::Result<(), String> {
+    let side = BUDGET.max_side as u32;
+    if width > side || height > side {
+        return Err(format!(
+            "the header declares {width}x{height} pixels, larger than the {side} pixels a side lookdev accepts"
+        ));
+    }
+    let texels = width as u64 * height as u64;
+    if texels * 4 * 2 / 127 > file_bytes {
+        return Err(format!(
+            "the header declares {width}x{height} pixels, more than a file of {} can hold: the file is truncated or its header is damaged",
+            input::size_text(file_bytes)
+        ));
+    }
+    Ok(())
 }
 
 /// Checks the shape and the texels, fixing them only when the options allow.
@@ -118,18 +143,26 @@ pub fn validate(
             format!("the environment is {width}x{height}, not 2:1 as an equirectangular map must be (--env-any-aspect reads it anyway)"),
         ));
     }
-    let bad = |v: f32| !v.is_finite() || v < 0.0;
+    let bad = |v: f32| !(0.0..=MAX_TEXEL).contains(&v);
     let count = |pred: &dyn Fn(f32) -> bool| texels.iter().filter(|t| t.iter().any(|&v| pred(v))).count();
     let (nan, inf, negative) = (count(&|v| v.is_nan()), count(&|v| v.is_infinite()), count(&|v| v < 0.0));
-    if nan + inf + negative > 0 {
-        let summary = format!("{nan} NaN, {inf} infinite and {negative} negative texels");
+    let too_bright = count(&|v| v.is_finite() && v > MAX_TEXEL);
+    if nan + inf + negative + too_bright > 0 {
+        let mut summary = format!("{nan} NaN, {inf} infinite and {negative} negative texels");
+        if too_bright > 0 {
+            summary.push_str(&format!(", and {too_bright} brighter than {MAX_TEXEL:e}, the most lookdev accepts"));
+        }
         if !options.clamp_invalid {
             return Err(Error::input_file(name, format!("the environment has {summary} (--env-clamp replaces them)")));
         }
-        let largest = texels.iter().flatten().copied().filter(|v| v.is_finite()).fold(0.0f32, f32::max);
+        let largest = texels.iter().flatten().copied().filter(|v| !bad(*v)).fold(0.0f32, f32::max);
         for texel in &mut texels {
             for v in texel.iter_mut().filter(|v| bad(**v)) {
-                *v = if *v == f32::INFINITY { largest } else { 0.0 };
+                *v = match *v {
+                    v if v.is_nan() || v < 0.0 => 0.0,
+                    f32::INFINITY => largest,
+                    _ => MAX_TEXEL,
+                };
             }
         }
         crate::warn(format!("{name}: clamped {summary}"));

@@ -15,7 +15,27 @@ pub use distribution::Distribution;
 pub use gpu::GpuEnvironment;
 pub use load::LoadOptions;
 
-/// A validated equirectangular radiance map: finite, non-negative, linear Rec.709.
+/// The brightest texel an environment may hold. With [`MAX_INTENSITY`], radiance stays below
+/// 1e24: far above any real light (the sun's disc is about 1e9 in the units of a typical HDRI),
+/// yet low enough that every sum and ratio the sampler and the accumulation form stays finite in
+/// 32-bit floats, so finite inputs never render infinite pixels.
+pub const MAX_TEXEL: f32 = 1e18;
+
+/// The largest environment intensity: room for maps stored in any units.
+pub const MAX_INTENSITY: f32 = 1e6;
+
+/// Checks an intensity (from a look, a flag or the viewer); the message starts with the value.
+pub fn check_intensity(intensity: f32) -> Result<(), String> {
+    if intensity.is_finite() && (0.0..=MAX_INTENSITY).contains(&intensity) {
+        Ok(())
+    } else {
+        let shown = if intensity.abs() >= 1e6 { format!("{intensity:e}") } else { intensity.to_string() };
+        Err(format!("intensity {shown} must be a number from 0 to {MAX_INTENSITY:e}"))
+    }
+}
+
+/// A validated equirectangular radiance map: finite, non-negative, at most [`MAX_TEXEL`], linear
+/// Rec.709.
 #[derive(Clone, Debug)]
 pub struct Environment {
     pub width: u32,

@@ -5,7 +5,7 @@
 //! [environment]          # optional; default: the embedded studio environment
 //! file = "studio.exr"    # relative to the look file's folder
 //! rotation = 0.0         # degrees about +Y; any finite number
-//! intensity = 1.0        # finite, >= 0
+//! intensity = 1.0        # 0 to 1e6
 //! background = true
 //!
 //! [model]                # optional; the BRDF model (docs/shading.md: BRDF models); --model overrides
@@ -14,7 +14,7 @@
 //! [render]               # optional; command-line flags override
 //! spp = 256              # >= 1
 //! seed = 0               # any u32
-//! exposure = 0.0         # stops; any finite number
+//! exposure = 0.0         # stops; within ±64
 //! tonemap = "neutral"    # linear | neutral | aces | agx
 //!
 //! [[object]]             # a layer stack; without `id` it is the default stack (at most one)
@@ -49,6 +49,7 @@ use serde::Deserialize;
 use super::library::Library;
 use super::params::{Param, Params, Value};
 use super::toml_input::{self as input, Field, Source};
+use crate::render::settings::MAX_EXPOSURE;
 use crate::render::tonemap::Tonemap;
 use crate::shading::model::{Model, ModelValue};
 
@@ -418,7 +419,7 @@ fn environment(src: &Source, raw: Option<EnvironmentFile>, folder: &Path) -> cra
     Ok(EnvironmentSettings {
         file: src.read("file", &raw.file, input::text)?.map(|f| folder.join(f)),
         rotation: src.read("rotation", &raw.rotation, input::number)?,
-        intensity: src.read("intensity", &raw.intensity, non_negative)?,
+        intensity: src.read("intensity", &raw.intensity, intensity)?,
         background: src.read("background", &raw.background, input::boolean)?,
     })
 }
@@ -430,7 +431,7 @@ fn render(src: &Source, raw: Option<RenderFile>) -> crate::Result<RenderSettings
     Ok(RenderSettings {
         spp: src.read("spp", &raw.spp, |k, v| input::unsigned(k, v, 1))?,
         seed: src.read("seed", &raw.seed, |k, v| input::unsigned(k, v, 0))?,
-        exposure: src.read("exposure", &raw.exposure, input::number)?,
+        exposure: src.read("exposure", &raw.exposure, exposure)?,
         tonemap: src.read("tonemap", &raw.tonemap, tonemap)?,
     })
 }
@@ -532,12 +533,19 @@ fn map_name(key: &str, value: &toml::Value) -> Result<String, String> {
     Ok(name)
 }
 
-fn non_negative(key: &str, value: &toml::Value) -> Result<f32, String> {
+fn intensity(key: &str, value: &toml::Value) -> Result<f32, String> {
     let x = input::number(key, value)?;
-    if x >= 0.0 {
+    crate::environment::check_intensity(x)
+        .map(|()| x)
+        .map_err(|_| format!("{key} = {x} must be a number from 0 to {:e}", crate::environment::MAX_INTENSITY))
+}
+
+fn exposure(key: &str, value: &toml::Value) -> Result<f32, String> {
+    let x = input::number(key, value)?;
+    if x.abs() <= MAX_EXPOSURE {
         Ok(x)
     } else {
-        Err(format!("{key} = {x} must be ≥ 0"))
+        Err(format!("{key} = {x} must be within ±{MAX_EXPOSURE} stops"))
     }
 }
 
@@ -551,11 +559,7 @@ fn unit_interval(key: &str, value: &toml::Value) -> Result<f32, String> {
 }
 
 fn tonemap(key: &str, value: &toml::Value) -> Result<Tonemap, String> {
-    let name = input::text(key, value)?;
-    Tonemap::from_name(&name).ok_or_else(|| {
-        let names = Tonemap::ALL.map(Tonemap::name);
-        input::unknown("tonemap", &name, "", &names)
-    })
+    Tonemap::parse(&input::text(key, value)?)
 }
 
 /// The bottom layer fills its object, so settings that only weight a layer do nothing there.

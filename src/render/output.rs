@@ -20,10 +20,25 @@ impl OutputFormat {
     }
 }
 
+/// Refuses to write an image with pixels that are not finite. Inputs are bounded so that none
+/// can arise; if one does, no file is better than a file that poisons a composite.
+pub fn check_finite(path: &Path, radiance: &[[f32; 4]]) -> Result<()> {
+    let bad = radiance.iter().filter(|p| !p.iter().all(|v| v.is_finite())).count();
+    if bad == 0 {
+        return Ok(());
+    }
+    Err(Error::gpu(format!(
+        "{}: not written: {bad} of {} pixels are not finite (NaN or infinite); this is a defect of lookdev, please report it",
+        path.display(),
+        radiance.len()
+    )))
+}
+
 /// Writes linear radiance as a float RGBA EXR. With a background, alpha is 1; without, it is the
 /// coverage and the colour is premultiplied by it, as compositors expect.
 pub fn write_exr(path: &Path, width: u32, height: u32, radiance: &[[f32; 4]], background: bool) -> Result<()> {
     use exr::prelude::{Encoding, Image, Layer, LayerAttributes, SpecificChannels, Vec2, WritableImage};
+    check_finite(path, radiance)?;
     let pixel = |position: Vec2<usize>| {
         let p = radiance[position.y() * width as usize + position.x()];
         (p[0], p[1], p[2], if background { 1.0 } else { p[3] })

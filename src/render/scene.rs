@@ -35,6 +35,9 @@ impl Scene {
         let covered = covered_object_ids(&gbuffer);
         let stacks = PackedStacks::pack(&look, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
         unused_stack_warnings(&look, &covered, &gbuffer_name).into_iter().for_each(crate::warn);
+        dark_render_warnings(&gbuffer, &gbuffer_name, &environment, settings.lighting.intensity)
+            .into_iter()
+            .for_each(crate::warn);
         Ok(Scene { gbuffer, gbuffer_name, look, environment, settings, stacks })
     }
 
@@ -59,13 +62,13 @@ impl Scene {
             look.set_everywhere(*param, *value).map_err(crate::Error::input)?;
         }
         let settings = Settings::resolve(&look, overrides)?;
-        let (gbuffer, gbuffer_name) = match gbuffer {
-            Some(path) => (GBuffer::read(path)?, path.to_path_buf()),
-            None => (GBuffer::shaderball(BUILTIN_SIZE, BUILTIN_SIZE), PathBuf::from("built-in shader ball")),
-        };
         let environment = match &settings.environment {
             Some(path) => environment::load::load(path, env_options)?,
             None => Environment::studio(),
+        };
+        let (gbuffer, gbuffer_name) = match gbuffer {
+            Some(path) => (GBuffer::read(path)?, path.to_path_buf()),
+            None => (GBuffer::shaderball(BUILTIN_SIZE, BUILTIN_SIZE), PathBuf::from("built-in shader ball")),
         };
         if implicit_default && had_stacks {
             let unstyled: Vec<String> = covered_object_ids(&gbuffer)
@@ -105,6 +108,30 @@ impl Scene {
         }
         Ok(())
     }
+}
+
+/// What makes a valid render come out black, or show only the background, each as a warning
+/// naming its cause: a g-buffer that covers no pixel, an environment that is 0 everywhere, an
+/// intensity of 0.
+pub fn dark_render_warnings(
+    gbuffer: &GBuffer,
+    gbuffer_name: &Path,
+    environment: &Environment,
+    intensity: f32,
+) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if gbuffer.coverage.iter().all(|&a| a == 0.0) {
+        warnings.push(format!(
+            "{}: no pixel is covered (A is 0 everywhere), so the render shows only the background",
+            gbuffer_name.display()
+        ));
+    }
+    if environment.texels.iter().flatten().all(|&v| v == 0.0) {
+        warnings.push(format!("{}: every texel is 0, so the render is black", environment.source));
+    } else if intensity == 0.0 {
+        warnings.push("the environment's intensity is 0, so the render is black".to_string());
+    }
+    warnings
 }
 
 /// The distinct object ids of the pixels that are shaded (coverage > 0), ascending.

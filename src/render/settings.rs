@@ -56,14 +56,17 @@ impl Settings {
                 Err(Error::input(format!("--{name} {v}: must be a finite number")))
             }
         };
-        let intensity = finite("intensity", overrides.intensity.or(env.intensity).unwrap_or(1.0))?;
-        if intensity < 0.0 {
-            return Err(Error::input(format!("--intensity {intensity}: must be at least 0")));
+        // The look's own value was checked where it was read, with its file and line.
+        if let Some(intensity) = overrides.intensity {
+            crate::environment::check_intensity(intensity).map_err(|e| Error::input(format!("--{e}")))?;
         }
-        let exposure = finite("exposure", overrides.exposure.or(render.exposure).unwrap_or(0.0))?;
+        let intensity = overrides.intensity.or(env.intensity).unwrap_or(1.0);
+        // The look's own value was checked where it was read, with its file and line.
+        let exposure = finite("exposure", overrides.exposure.unwrap_or(0.0))?;
         if exposure.abs() > MAX_EXPOSURE {
             return Err(Error::input(format!("--exposure {exposure}: must be within ±{MAX_EXPOSURE} stops")));
         }
+        let exposure = overrides.exposure.or(render.exposure).unwrap_or(0.0);
         let mut model = look.model.unwrap_or_default();
         for text in &overrides.model {
             model.set_from_text(text).map_err(Error::input)?;

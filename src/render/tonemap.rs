@@ -35,6 +35,12 @@ impl Tonemap {
         Tonemap::ALL.into_iter().find(|t| t.name() == name)
     }
 
+    /// The tone map of this name, or a message that lists the names and suggests the closest.
+    pub fn parse(name: &str) -> Result<Tonemap, String> {
+        Tonemap::from_name(name)
+            .ok_or_else(|| crate::material::unknown_key("tone map", name, "", &Tonemap::ALL.map(Tonemap::name)))
+    }
+
     /// The id the display kernel switches on.
     pub fn gpu_id(self) -> u32 {
         self as u32

@@ -17,7 +17,7 @@ use crate::gpu::context::{Presentation, ValidationCounter};
 use crate::gpu::{Context, ContextOptions};
 use crate::material::stack::{unused_stack_warnings, PackedStacks};
 use crate::material::Look;
-use crate::render::scene::{covered_object_ids, BUILTIN_SIZE};
+use crate::render::scene::{covered_object_ids, dark_render_warnings, BUILTIN_SIZE};
 use crate::render::settings::{Overrides, Settings};
 use crate::viewer_state::{Document, Edit, ObjectRef, Selection};
 use crate::{Error, Result};
@@ -66,17 +66,20 @@ impl Inputs {
             look.set_everywhere(*param, *value).map_err(Error::input)?;
         }
         let settings = Settings::resolve(&look, &options.overrides)?;
-        let (gbuffer, gbuffer_name) = match &options.gbuffer {
-            Some(path) => (GBuffer::read(path)?, path.clone()),
-            None => (GBuffer::shaderball(BUILTIN_SIZE, BUILTIN_SIZE), PathBuf::from("built-in shader ball")),
-        };
         let environment = match &settings.environment {
             Some(path) => environment::load::load(path, &options.env_options)?,
             None => Environment::studio(),
         };
+        let (gbuffer, gbuffer_name) = match &options.gbuffer {
+            Some(path) => (GBuffer::read(path)?, path.clone()),
+            None => (GBuffer::shaderball(BUILTIN_SIZE, BUILTIN_SIZE), PathBuf::from("built-in shader ball")),
+        };
         let covered = covered_object_ids(&gbuffer);
         PackedStacks::pack(&look, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
         unused_stack_warnings(&look, &covered, &gbuffer_name).into_iter().for_each(crate::warn);
+        dark_render_warnings(&gbuffer, &gbuffer_name, &environment, settings.lighting.intensity)
+            .into_iter()
+            .for_each(crate::warn);
         // B's inputs are checked here too, so that a bad one is an error before a window opens.
         model_with(settings.model, &options.compare_model, "--compare-model")?;
         if let Some(path) = &options.compare_look {

@@ -458,6 +458,7 @@ impl Session {
                 output::write_exr(path, width, height, &radiance, settings.lighting.background)?;
             }
             OutputFormat::Png => {
+                output::check_finite(path, &self.renderer.read_radiance()?)?;
                 let pixels = self.renderer.read_display(settings.exposure, settings.tonemap)?;
                 output::write_png(path, width, height, &pixels, !settings.lighting.background)?;
             }

@@ -286,9 +286,7 @@ impl State {
                 next.settings.lighting.rotation_degrees = degrees;
             }
             Edit::SetIntensity(intensity) => {
-                if !(intensity.is_finite() && intensity >= 0.0) {
-                    return Err(format!("intensity {intensity} must be a finite number ≥ 0"));
-                }
+                crate::environment::check_intensity(intensity)?;
                 next.settings.lighting.intensity = intensity;
             }
             Edit::SetBackground(background) => next.settings.lighting.background = background,
