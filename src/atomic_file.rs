@@ -19,6 +19,43 @@ fn temporary_path(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.{}-{write}.tmp", std::process::id()))
 }
 
+/// Removes the temporary files of earlier writes of `path` whose process is gone (killed
+/// mid-write, say), so that they do not pile up beside it. Best effort: what cannot be read or
+/// removed stays.
+fn remove_stale_temporaries(path: &Path) {
+    let (Some(name), Some(folder)) = (path.file_name(), path.parent()) else { return };
+    let prefix = format!(".{}.", name.to_string_lossy());
+    let folder = if folder.as_os_str().is_empty() { Path::new(".") } else { folder };
+    let Ok(entries) = std::fs::read_dir(folder) else { return };
+    for entry in entries.flatten() {
+        let file_name = entry.file_name().to_string_lossy().into_owned();
+        let Some(rest) = file_name.strip_prefix(&prefix).and_then(|r| r.strip_suffix(".tmp")) else { continue };
+        let Some(pid) = rest.split_once('-').and_then(|(pid, n)| n.parse::<u64>().ok().and(pid.parse::<u32>().ok()))
+        else {
+            continue;
+        };
+        if !process_is_alive(pid) {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
+/// Whether a process with this id exists (on other systems than Unix, always assumed so).
+fn process_is_alive(pid: u32) -> bool {
+    #[cfg(unix)]
+    {
+        let Ok(pid) = libc::pid_t::try_from(pid) else { return false };
+        // Signal 0 checks only that the process exists; EPERM means it does, as another user's.
+        let signalled = unsafe { libc::kill(pid, 0) } == 0;
+        signalled || std::io::Error::last_os_error().raw_os_error() == Some(libc::EPERM)
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = pid;
+        true
+    }
+}
+
 /// Writes `bytes` to `path` atomically, replacing any existing file.
 pub fn write(path: &Path, bytes: &[u8]) -> Result<()> {
     write_with(path, true, |file| file.write_all(bytes))
@@ -34,6 +71,7 @@ pub fn write_new(path: &Path, bytes: &[u8]) -> Result<()> {
 /// or by hard link (only if `path` does not exist). On any failure the temporary file is
 /// removed and `path` is untouched.
 pub fn write_with(path: &Path, replace: bool, fill: impl FnOnce(&mut File) -> std::io::Result<()>) -> Result<()> {
+    remove_stale_temporaries(path);
     let temporary = temporary_path(path);
     let result = (|| {
         let mut file = File::create(&temporary)?;
@@ -59,6 +97,23 @@ pub fn write_with(path: &Path, replace: bool, fill: impl FnOnce(&mut File) -> st
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn temporaries_of_dead_processes_are_removed_and_live_ones_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("gold.toml");
+        // No process has the largest pid; this one is alive.
+        let dead = dir.path().join(format!(".gold.toml.{}-0.tmp", i32::MAX));
+        let live = dir.path().join(format!(".gold.toml.{}-7.tmp", std::process::id()));
+        let other = dir.path().join(format!(".silver.toml.{}-0.tmp", i32::MAX));
+        for file in [&dead, &live, &other] {
+            std::fs::write(file, "partial").unwrap();
+        }
+        write(&path, b"name = \"gold\"\n").unwrap();
+        assert!(!dead.exists(), "a dead process's temporary is removed");
+        assert!(live.exists(), "a live process's temporary is kept");
+        assert!(other.exists(), "another file's temporary is left alone");
+    }
 
     #[test]
     fn a_failed_write_leaves_the_old_file_and_no_temporary() {

@@ -65,8 +65,23 @@ impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         // Keep it to one line, whatever the underlying library printed.
         let one_line: Vec<&str> = self.message.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
-        f.write_str(&one_line.join(" "))
+        f.write_str(&printable(&one_line.join(" ")))
     }
+}
+
+/// `text` with every control character escaped (`\x1b`, `\0`, `\u{9b}`), so that names read
+/// from files can neither break a message's one line nor send escape sequences to a terminal.
+pub fn printable(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '\0' => out.push_str("\\0"),
+            c if c.is_control() && (c as u32) < 0x80 => out.push_str(&format!("\\x{:02x}", c as u32)),
+            c if c.is_control() => out.push_str(&format!("\\u{{{:x}}}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out
 }
 
 impl std::error::Error for Error {}
@@ -74,5 +89,16 @@ impl std::error::Error for Error {}
 impl From<ash::vk::Result> for Error {
     fn from(result: ash::vk::Result) -> Self {
         Error::gpu(format!("Vulkan call failed: {result}"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_are_one_line_with_control_characters_escaped() {
+        let error = Error::input_file("look.toml", "no preset named '\u{1b}[31mred\0'\nsecond line\u{9b}");
+        assert_eq!(error.to_string(), "look.toml: no preset named '\\x1b[31mred\\0' second line\\u{9b}");
     }
 }

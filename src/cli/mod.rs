@@ -72,12 +72,7 @@ pub fn run(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<()> {
         {
             e.exit()
         }
-        Err(e) => {
-            // clap explains at length; keep the one line that names the problem.
-            let text = e.to_string();
-            let first = text.lines().next().unwrap_or("invalid arguments").trim_start_matches("error: ");
-            return Err(Error::input(format!("{first} (see lookdev --help)")));
-        }
+        Err(e) => return Err(Error::input(format!("{} (see lookdev --help)", clap_problem(&e)))),
     };
     match cli.command {
         Command::Render(args) => render::run(args),
@@ -95,6 +90,31 @@ pub fn run(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<()> {
     }
 }
 
+/// clap's error on one line: its first line, the arguments it lists on the lines below (the
+/// missing required ones), and its suggestion for a misspelled flag, subcommand or value.
+fn clap_problem(e: &clap::Error) -> String {
+    use clap::error::{ContextKind, ContextValue};
+    let text = e.render().to_string();
+    let first = text.lines().next().unwrap_or("invalid arguments").trim_start_matches("error: ");
+    let mut problem = match (e.kind(), e.get(ContextKind::InvalidArg)) {
+        (clap::error::ErrorKind::MissingRequiredArgument, Some(ContextValue::Strings(missing))) => {
+            format!("the following required arguments were not provided: {}", missing.join(", "))
+        }
+        _ => first.to_string(),
+    };
+    let suggested = [ContextKind::SuggestedArg, ContextKind::SuggestedSubcommand, ContextKind::SuggestedValue]
+        .into_iter()
+        .find_map(|kind| match e.get(kind) {
+            Some(ContextValue::String(s)) => Some(s.clone()),
+            Some(ContextValue::Strings(s)) if !s.is_empty() => Some(s.join("' or '")),
+            _ => None,
+        });
+    if let Some(suggested) = suggested {
+        problem.push_str(&format!("; did you mean '{suggested}'?"));
+    }
+    problem
+}
+
 fn list_devices() -> Result<()> {
     for (name, kind) in crate::gpu::context::list_devices()? {
         println!("{name} ({kind})");
@@ -108,7 +128,8 @@ pub fn parse_set(text: &str) -> Result<(Param, Value)> {
         .split_once('=')
         .ok_or_else(|| Error::input(format!("--set {text}: expected NAME=VALUE, e.g. roughness=0.3")))?;
     let param = Param::from_name(name.trim()).ok_or_else(|| {
-        Error::input(format!("--set {text}: unknown parameter '{name}' (expected {})", Param::all_names()))
+        let names = Param::ALL.map(Param::name);
+        Error::input(format!("--set {text}: {}", crate::material::unknown_key("parameter", name.trim(), "", &names)))
     })?;
     let value = parse_value(param, value).map_err(|e| Error::input(format!("--set {text}: {e}")))?;
     Ok((param, value))

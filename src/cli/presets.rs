@@ -97,11 +97,19 @@ pub fn run(args: PresetsArgs) -> Result<()> {
     }
 }
 
-/// Every preset the standard library resolves, optionally with a tag; broken files are errors.
+/// Every preset the standard library resolves, optionally with a tag. A user preset that
+/// fails to load is skipped with a warning naming its file, so one broken file never hides the
+/// rest of the library.
 fn presets_with_tag(tag: Option<&str>) -> Result<Vec<(Preset, Origin)>> {
     let mut out = Vec::new();
     for (_, origin, preset) in Library::standard().entries() {
-        let preset = preset.map_err(Error::input)?;
+        let preset = match preset {
+            Ok(preset) => preset,
+            Err(problem) => {
+                crate::warn(format!("{problem}; skipped"));
+                continue;
+            }
+        };
         if tag.is_none_or(|t| preset.tags.iter().any(|p| p == t)) {
             out.push((preset, origin));
         }
@@ -156,6 +164,10 @@ fn show(name: &str) -> Result<()> {
 
 fn save(args: SaveArgs) -> Result<()> {
     library::check_preset_name(&args.name)?;
+    let tags: Vec<String> = args.tags.iter().map(|t| t.trim().to_string()).collect();
+    if tags.iter().any(String::is_empty) {
+        return Err(Error::input(format!("--tags {}: a tag must not be empty", args.tags.join(","))));
+    }
     let dir = library::require_user_library_dir()?;
     let (params, set) = match &args.from_look {
         Some(look) => layer_params(look, args.object.as_deref().unwrap_or_default(), args.layer.unwrap_or(0))?,
@@ -177,7 +189,7 @@ fn save(args: SaveArgs) -> Result<()> {
     set.dedup();
     // The eleven parameters only: a look's complex IOR belongs to the preset it came from.
     let params = Params { ior_edge: [0.0; 3], ..params };
-    let preset = Preset { name: args.name, description: args.description, tags: args.tags, params, set, ior: None };
+    let preset = Preset { name: args.name, description: args.description, tags, params, set, ior: None };
     let path = library::save_preset(&dir, &preset, args.force)?;
     println!("{}", path.display());
     Ok(())

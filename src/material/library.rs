@@ -31,16 +31,28 @@ pub fn require_user_library_dir() -> crate::Result<PathBuf> {
     user_library_dir().ok_or_else(|| crate::Error::input("no user library: set LOOKDEV_PRESETS or HOME"))
 }
 
+/// The longest preset name, in bytes. The import names presets and masks after materials by the
+/// same rule (`crate::asset::channel_name`), so it keeps `<name>.toml` and the g-buffer's
+/// `mask.<name>` far within the 255 bytes file systems and OpenEXR allow.
+pub const MAX_NAME_BYTES: usize = 64;
+
 /// A name a preset may be saved under: lowercase letters, digits, '-' and '_', so that it is a
 /// file name everywhere and never looks like a path.
 pub fn check_preset_name(name: &str) -> crate::Result<()> {
     let valid =
         !name.is_empty() && name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '_');
-    if valid {
-        Ok(())
-    } else {
-        Err(crate::Error::input(format!("'{name}' is not a preset name: use lowercase letters, digits, '-' and '_'")))
+    if !valid {
+        return Err(crate::Error::input(format!(
+            "'{name}' is not a preset name: use lowercase letters, digits, '-' and '_'"
+        )));
     }
+    if name.len() > MAX_NAME_BYTES {
+        return Err(crate::Error::input(format!(
+            "'{name}' is not a preset name: it has {} characters, and at most {MAX_NAME_BYTES} are allowed",
+            name.len()
+        )));
+    }
+    Ok(())
 }
 
 /// Writes `preset` as `<dir>/<name>.toml`, creating `dir` if needed, and returns the path. The
@@ -52,6 +64,8 @@ pub fn save_preset(dir: &Path, preset: &Preset, force: bool) -> crate::Result<Pa
         .map_err(|e| crate::Error::io(dir, format!("cannot create the preset library: {e}")))?;
     let path = dir.join(format!("{}.toml", preset.name));
     let text = preset.to_toml();
+    // What is saved must load: a file the library cannot read back would break every listing.
+    Preset::parse(&text, &path).map_err(|e| crate::Error::input(format!("not saved: {e}")))?;
     if force {
         crate::atomic_file::write(&path, text.as_bytes())?;
     } else {
@@ -211,17 +225,21 @@ impl Library {
 
     fn unknown(&self, name: &str) -> String {
         let names = self.names();
-        let nearest = closest(name, names.iter().map(String::as_str));
+        let nearest = closest(name, names.iter().map(String::as_str).filter(|n| *n != name));
         let shown: Vec<&str> = nearest.into_iter().take(3).collect();
         format!("no preset named '{name}' (closest: {})", shown.join(", "))
     }
 
-    /// Every name the library can resolve: `*.toml` files in the search folders and the
-    /// built-ins. Used only to suggest names, so an unreadable folder is simply skipped.
+    /// Every name the library can resolve: the `*.toml` files in the search folders that are
+    /// presets (not the look itself, nor other looks beside it), and the built-ins. Used only
+    /// to suggest names, so an unreadable folder or file is simply skipped.
     fn names(&self) -> Vec<String> {
         let mut names: Vec<String> = builtin_names().into_iter().map(String::from).collect();
         for dir in &self.search {
-            names.extend(toml_stems(dir));
+            names.extend(toml_stems(dir).into_iter().filter(|stem| {
+                let path = dir.join(format!("{stem}.toml"));
+                self.look.as_deref() != Some(path.as_path()) && Preset::load(&path).is_ok()
+            }));
         }
         names.sort();
         names.dedup();
