@@ -27,6 +27,7 @@ pub fn check(root: &Root) -> Result<Vec<String>, String> {
     check_buffer_views(root)?;
     check_meshes(root)?;
     check_accessors(root)?;
+    check_images(root)?;
     check_nodes(root)?;
     Ok(factor_warnings(root))
 }
@@ -261,6 +262,23 @@ fn check_meshes(root: &Root) -> Result<(), String> {
     Ok(())
 }
 
+/// Each image has its data in a buffer view (with its MIME type) or behind a URI.
+fn check_images(root: &Root) -> Result<(), String> {
+    for (i, image) in root.images.iter().enumerate() {
+        let path = format!("images[{i}]");
+        match (&image.buffer_view, &image.uri, &image.mime_type) {
+            (Some(view), None, Some(_)) => {
+                in_range(&format!("{path}.bufferView"), "buffer view", view.value(), root.buffer_views.len())?
+            }
+            (Some(_), None, None) => return Err(format!("{path}: an image in a buffer view needs its mimeType")),
+            (None, Some(_), _) => {}
+            (Some(_), Some(_), _) => return Err(format!("{path}: it has both a uri and a bufferView")),
+            (None, None, _) => return Err(format!("{path}: it has neither a uri nor a bufferView")),
+        }
+    }
+    Ok(())
+}
+
 fn check_nodes(root: &Root) -> Result<(), String> {
     let count = root.nodes.len();
     let mut parent: Vec<Option<usize>> = vec![None; count];
@@ -364,7 +382,10 @@ mod tests {
     #[test]
     fn each_claim_of_the_json_is_checked_and_named_by_its_path() {
         type Edit = fn(&mut serde_json::Value);
-        let cases: [(&str, Edit); 9] = [
+        let cases: [(&str, Edit); 10] = [
+            ("images[0]: it has neither a uri nor a bufferView", |j| {
+                j["images"] = serde_json::json!([{"name": "lost"}])
+            }),
             ("meshes[0].primitives[0].attributes[\"POSITION\"]: accessor 99 does not exist (the file has 2)", |j| {
                 j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 99.into()
             }),

@@ -7,7 +7,9 @@
 //! - deep data, and images or tiles wider or taller than [`Budget::max_side`];
 //! - pixel data larger than [`Budget::max_decoded_bytes`];
 //! - pixel data that the file cannot hold: more than its size times the best ratio its
-//!   compression can reach ([`max_ratio`]), or more chunks than the file has room for.
+//!   compression can reach ([`max_ratio`]), or more chunks than the file has room for;
+//! - DWAA and DWAB chunks whose own headers claim sections far larger than the chunk's pixels
+//!   (the decoder sizes its buffers from those counters).
 
 use exr::compression::Compression;
 use exr::meta::attribute::{LevelMode, SampleType};
@@ -91,6 +93,9 @@ pub fn check(bytes: &[u8], budget: &Budget) -> Result<Declared, String> {
             super::size_text(budget.max_decoded_bytes)
         ));
     }
+    if meta.headers.iter().any(|h| matches!(h.compression, Compression::DWAA(_) | Compression::DWAB(_))) {
+        check_dwa_chunks(bytes)?;
+    }
     if stored_bytes > file_bytes || chunks.saturating_mul(MIN_CHUNK_BYTES) > file_bytes {
         return Err(format!(
             "the header declares {} of pixel data ({}x{}) in {chunks} chunks, more than a file of {} can hold: \
@@ -102,6 +107,56 @@ pub fn check(bytes: &[u8], budget: &Budget) -> Result<Declared, String> {
         ));
     }
     Ok(declared)
+}
+
+/// The counters at the start of a DWA chunk that size the decoder's buffers: the unknown,
+/// AC, DC and RLE sections' byte sizes and coefficient counts (OpenEXR's DwaCompressor layout:
+/// eleven little-endian u64, the version first and the AC coder last).
+const DWA_SIZE_COUNTERS: std::ops::Range<usize> = 1..10;
+
+/// How much larger than its block's decoded pixels a DWA section may claim to be: a block of
+/// one 8×8 DCT block per two-byte sample, padded at the edges, is the worst real case (32).
+const DWA_SECTION_RATIO: u64 = 64;
+
+/// Reads every chunk of a DWA file and checks the counters in its header against the size of
+/// the pixels it holds, before the decoder allocates from them.
+fn check_dwa_chunks(bytes: &[u8]) -> Result<(), String> {
+    use exr::block::chunk::CompressedBlock;
+    let reader = exr::block::read(std::io::Cursor::new(bytes), false).map_err(|e| unreadable(&e))?;
+    let headers = reader.headers().to_vec();
+    for chunk in reader.all_chunks(false).map_err(|e| unreadable(&e))? {
+        let chunk = chunk.map_err(|e| unreadable(&e))?;
+        let header = headers.get(chunk.layer_index).ok_or("a chunk names a part the file does not have")?;
+        if !matches!(header.compression, Compression::DWAA(_) | Compression::DWAB(_)) {
+            continue;
+        }
+        let data = match &chunk.compressed_block {
+            CompressedBlock::ScanLine(block) => &block.compressed_pixels_le,
+            CompressedBlock::Tile(block) => &block.compressed_pixels_le,
+            _ => continue,
+        };
+        let block = header
+            .get_block_data_indices(&chunk.compressed_block)
+            .and_then(|tile| header.get_absolute_block_pixel_coordinates(tile))
+            .map_err(|e| unreadable(&e))?;
+        let bytes_per_pixel: u64 = header.channels.list.iter().map(|c| sample_bytes(c.sample_type)).sum();
+        let pixels = block.size.width() as u64 * block.size.height() as u64 * bytes_per_pixel;
+        let limit = pixels * DWA_SECTION_RATIO + (64 << 10);
+        // A chunk stored uncompressed (as small ones are) has no DWA header.
+        if data.len() as u64 == pixels || data.len() < 88 {
+            continue;
+        }
+        for counter in DWA_SIZE_COUNTERS {
+            let value = u64::from_le_bytes(data[counter * 8..counter * 8 + 8].try_into().expect("8 bytes"));
+            if value > limit {
+                return Err(format!(
+                    "a DWA chunk claims a section of {value} bytes for {} of pixels: the file is damaged",
+                    super::size_text(pixels)
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// An upper bound on decoded bytes per stored byte for a compression: 1 for none, 64 for RLE
