@@ -18,6 +18,8 @@ pub enum ErrorKind {
     Io,
     /// `lookdev lint` found implausible values (already printed). Exit code 1.
     Lint,
+    /// A defect of lookdev itself: a panic, caught and reported on one line. Exit code 1.
+    Internal,
 }
 
 /// A one-line, user-facing error.
@@ -44,6 +46,13 @@ impl Error {
         Error { kind: ErrorKind::Gpu, message: problem.to_string() }
     }
 
+    pub fn internal(problem: impl fmt::Display) -> Self {
+        Error {
+            kind: ErrorKind::Internal,
+            message: format!("internal error ({problem}); this is a defect of lookdev, please report it"),
+        }
+    }
+
     pub fn lint(summary: impl fmt::Display) -> Self {
         Error { kind: ErrorKind::Lint, message: summary.to_string() }
     }
@@ -56,7 +65,7 @@ impl Error {
     pub fn exit_code(&self) -> i32 {
         match self.kind {
             ErrorKind::Input => 2,
-            ErrorKind::Gpu | ErrorKind::Io | ErrorKind::Lint => 1,
+            ErrorKind::Gpu | ErrorKind::Io | ErrorKind::Lint | ErrorKind::Internal => 1,
         }
     }
 }
@@ -66,6 +75,17 @@ impl fmt::Display for Error {
         // Keep it to one line, whatever the underlying library printed.
         let one_line: Vec<&str> = self.message.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
         f.write_str(&printable(&one_line.join(" ")))
+    }
+}
+
+/// A number as messages show it: plainly, or in scientific notation when very large or very
+/// small, so that `1e38` is not written out as 39 digits.
+pub fn number_text<T: Into<f64> + Copy + fmt::Display + fmt::LowerExp>(x: T) -> String {
+    let magnitude = x.into().abs();
+    if magnitude != 0.0 && magnitude.is_finite() && !(1e-4..1e6).contains(&magnitude) {
+        format!("{x:e}")
+    } else {
+        x.to_string()
     }
 }
 
@@ -95,6 +115,15 @@ impl From<ash::vk::Result> for Error {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_read_as_written() {
+        assert_eq!(number_text(1e38), "1e38");
+        assert_eq!(number_text(3e38f32), "3e38");
+        assert_eq!(number_text(0.25), "0.25");
+        assert_eq!(number_text(-100.0f32), "-100");
+        assert_eq!(number_text(1e-6), "1e-6");
+    }
 
     #[test]
     fn messages_are_one_line_with_control_characters_escaped() {

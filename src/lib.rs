@@ -21,7 +21,7 @@ pub mod shading;
 pub mod viewer;
 pub mod viewer_state;
 
-pub use error::{printable, Error, ErrorKind, Result};
+pub use error::{number_text, printable, Error, ErrorKind, Result};
 
 /// Prints a non-fatal warning to stderr, in the same one-line style as errors.
 pub fn warn(message: impl std::fmt::Display) {

@@ -47,6 +47,14 @@ pub struct BakeArgs {
     pub quiet: bool,
 }
 
+/// The flags' values, before anything is read.
+pub fn check(args: &BakeArgs) -> Result<()> {
+    if !(1..=MAX_SAMPLES).contains(&args.samples) {
+        return Err(Error::input(format!("--samples {}: must be 1 to {MAX_SAMPLES}", args.samples)));
+    }
+    Ok(())
+}
+
 pub fn run(args: BakeArgs) -> Result<()> {
     if !args.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
         return Err(Error::input_file(&args.out, "a g-buffer is written as an .exr file"));
@@ -55,9 +63,6 @@ pub fn run(args: BakeArgs) -> Result<()> {
         if !parent.is_dir() {
             return Err(Error::input_file(&args.out, "the output folder does not exist"));
         }
-    }
-    if !(1..=MAX_SAMPLES).contains(&args.samples) {
-        return Err(Error::input(format!("--samples {}: must be 1 to {MAX_SAMPLES}", args.samples)));
     }
     let camera = match (&args.camera, args.auto_camera) {
         (Some(name), _) => CameraChoice::Named(name.clone()),

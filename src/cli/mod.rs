@@ -58,9 +58,17 @@ pub enum Command {
     Devices,
 }
 
-/// Parses the arguments and runs the command; the caller turns the error into an exit code.
-pub fn run(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<()> {
-    let cli = match Cli::try_parse_from(args) {
+/// The command line, parsed: a command to run, or text clap prints (help, the version).
+pub enum Parsed {
+    Run(Box<Cli>),
+    Print(clap::Error),
+}
+
+/// Parses the arguments without running anything: the command with its flags' values checked
+/// ([`check`]), help or version text, or the one-line error.
+pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parsed> {
+    let args: Vec<std::ffi::OsString> = args.into_iter().collect();
+    let cli = match Cli::try_parse_from(&args) {
         Ok(cli) => cli,
         Err(e)
             if matches!(
@@ -70,9 +78,69 @@ pub fn run(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<()> {
                     | clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
             ) =>
         {
-            e.exit()
+            return Ok(Parsed::Print(e))
+        }
+        Err(e) if e.kind() == clap::error::ErrorKind::InvalidUtf8 => {
+            // clap does not say which; name it, as the shell would show it.
+            let (index, arg) = args.iter().enumerate().find(|(_, a)| a.to_str().is_none()).unwrap_or((0, &args[0]));
+            return Err(Error::input(format!("argument {index} '{}' is not valid UTF-8", arg.to_string_lossy())));
         }
         Err(e) => return Err(Error::input(format!("{} (see lookdev --help)", clap_problem(&e)))),
+    };
+    check(&cli.command)?;
+    Ok(Parsed::Run(Box::new(cli)))
+}
+
+/// Checks the values of a command's flags that need no file and no device, so that a bad one is
+/// refused before anything is read or started.
+pub fn check(command: &Command) -> Result<()> {
+    match command {
+        Command::Render(a) => check_look_flags(&a.set, &a.lighting, &a.sampling, &a.display),
+        Command::Turntable(a) => check_look_flags(&a.set, &a.lighting, &a.sampling, &a.display),
+        Command::View(a) => check_look_flags(&a.set, &a.lighting, &a.sampling, &a.display),
+        Command::Bake(a) => bake::check(a),
+        Command::Presets(a) => presets::check(a),
+        _ => Ok(()),
+    }
+}
+
+/// `--set`, and the look's settings as the lighting, sampling and display flags override them.
+fn check_look_flags(
+    sets: &[String],
+    lighting: &inputs::LightingArgs,
+    sampling: &inputs::SamplingArgs,
+    display: &inputs::DisplayArgs,
+) -> Result<()> {
+    inputs::parse_sets(sets)?;
+    let overrides = inputs::overrides(lighting, sampling, display);
+    crate::render::settings::Settings::resolve(&crate::material::Look::default_material(), &overrides).map(|_| ())
+}
+
+/// Runs `run`, turning a panic into an [`ErrorKind::Internal`](crate::ErrorKind) error: every
+/// input is validated before use, so a panic is a defect, and even a defect ends in one line.
+/// `place` gives where the panic happened, when a panic hook recorded it.
+pub fn catching_panics(run: impl FnOnce() -> Result<()>, place: impl FnOnce() -> Option<String>) -> Result<()> {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)) {
+        Ok(result) => result,
+        Err(payload) => {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "a panic".to_string());
+            Err(Error::internal(match place() {
+                Some(place) => format!("{what} at {place}"),
+                None => what,
+            }))
+        }
+    }
+}
+
+/// Parses the arguments and runs the command; the caller turns the error into an exit code.
+pub fn run(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<()> {
+    let cli = match parse(args)? {
+        Parsed::Run(cli) => cli,
+        Parsed::Print(text) => text.exit(),
     };
     match cli.command {
         Command::Render(args) => render::run(args),
@@ -113,6 +181,22 @@ fn clap_problem(e: &clap::Error) -> String {
         problem.push_str(&format!("; did you mean '{suggested}'?"));
     }
     problem
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_panic_becomes_one_line_naming_it_a_defect() {
+        let error = catching_panics(|| panic!("index out of bounds"), || Some("src/x.rs:3".into())).unwrap_err();
+        assert_eq!(error.exit_code(), 1);
+        assert_eq!(
+            error.to_string(),
+            "internal error (index out of bounds at src/x.rs:3); this is a defect of lookdev, please report it"
+        );
+        assert_eq!(catching_panics(|| Err(Error::input("bad")), || None).unwrap_err().exit_code(), 2);
+    }
 }
 
 fn list_devices() -> Result<()> {

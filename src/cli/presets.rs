@@ -162,12 +162,28 @@ fn show(name: &str) -> Result<()> {
     Ok(())
 }
 
-fn save(args: SaveArgs) -> Result<()> {
-    library::check_preset_name(&args.name)?;
-    let tags: Vec<String> = args.tags.iter().map(|t| t.trim().to_string()).collect();
-    if tags.iter().any(String::is_empty) {
-        return Err(Error::input(format!("--tags {}: a tag must not be empty", args.tags.join(","))));
+/// The flags' values, before anything is read.
+pub fn check(args: &PresetsArgs) -> Result<()> {
+    match &args.command {
+        PresetsCommand::Save(save) => {
+            library::check_preset_name(&save.name)?;
+            tags(&save.tags).map(|_| ())
+        }
+        _ => Ok(()),
     }
+}
+
+/// `--tags`, trimmed; an empty tag is refused, since a preset file cannot hold one.
+fn tags(given: &[String]) -> Result<Vec<String>> {
+    let tags: Vec<String> = given.iter().map(|t| t.trim().to_string()).collect();
+    if tags.iter().any(String::is_empty) {
+        return Err(Error::input(format!("--tags {}: a tag must not be empty", given.join(","))));
+    }
+    Ok(tags)
+}
+
+fn save(args: SaveArgs) -> Result<()> {
+    let tags = tags(&args.tags)?;
     let dir = library::require_user_library_dir()?;
     let (params, set) = match &args.from_look {
         Some(look) => layer_params(look, args.object.as_deref().unwrap_or_default(), args.layer.unwrap_or(0))?,

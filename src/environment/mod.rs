@@ -29,8 +29,7 @@ pub fn check_intensity(intensity: f32) -> Result<(), String> {
     if intensity.is_finite() && (0.0..=MAX_INTENSITY).contains(&intensity) {
         Ok(())
     } else {
-        let shown = if intensity.abs() >= 1e6 { format!("{intensity:e}") } else { intensity.to_string() };
-        Err(format!("intensity {shown} must be a number from 0 to {MAX_INTENSITY:e}"))
+        Err(format!("intensity {} must be a number from 0 to {MAX_INTENSITY:e}", crate::number_text(intensity)))
     }
 }
 

@@ -13,6 +13,7 @@
 
 pub mod exr;
 pub mod image;
+pub mod readers;
 
 use crate::{Error, Result};
 use std::fs::File;

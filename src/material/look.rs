@@ -535,9 +535,9 @@ fn map_name(key: &str, value: &toml::Value) -> Result<String, String> {
 
 fn intensity(key: &str, value: &toml::Value) -> Result<f32, String> {
     let x = input::number(key, value)?;
-    crate::environment::check_intensity(x)
-        .map(|()| x)
-        .map_err(|_| format!("{key} = {x} must be a number from 0 to {:e}", crate::environment::MAX_INTENSITY))
+    crate::environment::check_intensity(x).map(|()| x).map_err(|_| {
+        format!("{key} = {} must be a number from 0 to {:e}", crate::number_text(x), crate::environment::MAX_INTENSITY)
+    })
 }
 
 fn exposure(key: &str, value: &toml::Value) -> Result<f32, String> {
@@ -545,7 +545,7 @@ fn exposure(key: &str, value: &toml::Value) -> Result<f32, String> {
     if x.abs() <= MAX_EXPOSURE {
         Ok(x)
     } else {
-        Err(format!("{key} = {x} must be within ±{MAX_EXPOSURE} stops"))
+        Err(format!("{key} = {} must be within ±{MAX_EXPOSURE} stops", crate::number_text(x)))
     }
 }
 

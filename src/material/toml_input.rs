@@ -249,7 +249,7 @@ pub(crate) fn number(key: &str, value: &toml::Value) -> Result<f32, String> {
     if narrowed.is_finite() {
         Ok(narrowed)
     } else {
-        Err(format!("{key} = {x} is not a finite number"))
+        Err(format!("{key} = {} is not a finite number", crate::number_text(x)))
     }
 }
 
