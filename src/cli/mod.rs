@@ -183,22 +183,6 @@ fn clap_problem(e: &clap::Error) -> String {
     problem
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_panic_becomes_one_line_naming_it_a_defect() {
-        let error = catching_panics(|| panic!("index out of bounds"), || Some("src/x.rs:3".into())).unwrap_err();
-        assert_eq!(error.exit_code(), 1);
-        assert_eq!(
-            error.to_string(),
-            "internal error (index out of bounds at src/x.rs:3); this is a defect of lookdev, please report it"
-        );
-        assert_eq!(catching_panics(|| Err(Error::input("bad")), || None).unwrap_err().exit_code(), 2);
-    }
-}
-
 fn list_devices() -> Result<()> {
     for (name, kind) in crate::gpu::context::list_devices()? {
         println!("{name} ({kind})");
@@ -229,5 +213,21 @@ fn check_validation(counter: &crate::gpu::context::ValidationCounter) -> Result<
     match counter.errors() {
         0 => Ok(()),
         n => Err(Error::gpu(format!("Vulkan validation reported {n} error(s); see above"))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_panic_becomes_one_line_naming_it_a_defect() {
+        let error = catching_panics(|| panic!("index out of bounds"), || Some("src/x.rs:3".into())).unwrap_err();
+        assert_eq!(error.exit_code(), 1);
+        assert_eq!(
+            error.to_string(),
+            "internal error (index out of bounds at src/x.rs:3); this is a defect of lookdev, please report it"
+        );
+        assert_eq!(catching_panics(|| Err(Error::input("bad")), || None).unwrap_err().exit_code(), 2);
     }
 }
