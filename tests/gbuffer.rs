@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use exr::prelude::*;
-use lookdev::gbuffer::{stable_tangent, GBuffer};
+use lookdev::gbuffer::{stable_tangent, GBuffer, SourceOptions};
 use lookdev::ErrorKind;
 
 // ---------------------------------------------------------------------------------------------
@@ -363,7 +363,7 @@ fn garbage_and_truncated_files_are_errors_not_panics() {
 }
 
 #[test]
-fn multi_part_files_are_refused_with_the_part_count() {
+fn multi_part_files_of_several_images_need_a_part_chosen() {
     let disc = Disc::new(8, 8);
     let path = scratch("two-parts.exr");
     let mut first = layer(disc.size(), disc.half_normals(), Compression::ZIP16, &[]);
@@ -374,7 +374,11 @@ fn multi_part_files_are_refused_with_the_part_count() {
         .write()
         .to_file(&path)
         .unwrap();
-    read_err(&path, &["the file has 2 parts", "only single-part g-buffers are supported"]);
+    read_err(&path, &["several parts have the channel N.X", "choose a part with --gbuffer-layer (parts: one, two)"]);
+    let options = SourceOptions { layer: Some("two".into()), ..SourceOptions::default() };
+    let read = GBuffer::read_with(&path, &options).expect("--gbuffer-layer chooses a part");
+    assert_eq!(read.detected.layer.as_deref(), Some("two"));
+    assert_eq!(read.gbuffer.width, 8);
 }
 
 #[test]

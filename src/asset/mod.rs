@@ -13,7 +13,7 @@ pub mod camera;
 pub mod geometry;
 pub mod import;
 pub mod materials;
-mod names;
+pub mod names;
 pub mod textures;
 pub mod validate;
 

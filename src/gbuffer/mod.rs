@@ -70,13 +70,16 @@ mod procedural;
 mod read;
 mod scene;
 mod shaderball;
+pub mod source;
 mod validate;
 mod write;
 
 pub(crate) use frame::orthogonalize;
 pub use frame::stable_tangent;
+pub use read::Read;
 /// Object ids of the built-in scene.
 pub use scene::{BALL_ID, PEDESTAL_ID};
+pub use source::{SourceOptions, Up};
 
 use std::collections::BTreeMap;
 

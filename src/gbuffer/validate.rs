@@ -6,10 +6,10 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use exr::prelude::FlatSamples;
 use glam::Vec3;
 
 use super::frame::{orthogonalize, stable_tangent};
+use super::source::raw::Samples;
 use super::{
     GBuffer, COLOR_MAP_CHANNELS, COVERAGE_CHANNEL, DEFAULT_VIEW, MAP_PREFIX, MASK_PREFIX, NORMAL_CHANNELS,
     OBJECT_ID_CHANNEL, OBJECT_NAME_PREFIX, PLACEHOLDER_NORMAL, TANGENT_CHANNELS, VIEW_CHANNELS,
@@ -21,7 +21,7 @@ pub(crate) struct RawImage {
     pub width: usize,
     pub height: usize,
     /// Channel name (decoded as UTF-8) to samples, row-major, row 0 at the top.
-    pub channels: BTreeMap<String, FlatSamples>,
+    pub channels: BTreeMap<String, Samples>,
     /// Header attributes named `objectName.*`, with their value where it is text.
     pub object_name_attributes: Vec<(String, Option<String>)>,
     /// Header text attributes named `maskName.<mask>`, by mask name.
@@ -70,7 +70,7 @@ impl Checker<'_> {
             Some(raw_view) => self.views(raw_view)?,
             None => vec![Vec3::from(DEFAULT_VIEW); normal.len()],
         };
-        self.facing(&normal, &view, &coverage)?;
+        self.facing(&normal, &view, &coverage, raw_view.is_some())?;
         let tangent = match &raw_tangent {
             Some(raw_tangent) => self.tangents(&normal, raw_tangent, &coverage),
             None => normal.iter().map(|n| stable_tangent(n.to_array())).collect(),
@@ -137,8 +137,7 @@ impl Checker<'_> {
     /// channels do not, and are only accepted among the ignored ones.
     fn sample_counts(&self, raw: &RawImage) -> Result<()> {
         let pixels = raw.width * raw.height;
-        let wrong_count =
-            |(name, samples): &(&String, &FlatSamples)| is_gbuffer_channel(name) && samples.len() != pixels;
+        let wrong_count = |(name, samples): &(&String, &Samples)| is_gbuffer_channel(name) && samples.len() != pixels;
         match raw.channels.iter().find(wrong_count) {
             Some((name, samples)) => Err(self.error(format!(
                 "channel {name} has {} samples for {}x{} pixels; subsampled channels are not supported",
@@ -181,7 +180,7 @@ impl Checker<'_> {
     }
 
     /// A scalar channel that must be finite, clamped into \[0,1\] with a warning.
-    fn unit_interval(&mut self, name: &str, samples: &FlatSamples) -> Result<Vec<f32>> {
+    fn unit_interval(&mut self, name: &str, samples: &Samples) -> Result<Vec<f32>> {
         let mut values = to_f32(samples);
         let mut non_finite = Offenders::default();
         let mut clamped = 0usize;
@@ -284,7 +283,7 @@ impl Checker<'_> {
     /// zero there). A few are normal (bump and normal maps produce them) and get a warning; most
     /// of the image facing away means V points from the eye to the surface instead of from the
     /// surface to the eye, which is an error rather than a silently black render.
-    fn facing(&mut self, normals: &[Vec3], views: &[Vec3], coverage: &[f32]) -> Result<()> {
+    fn facing(&mut self, normals: &[Vec3], views: &[Vec3], coverage: &[f32], view_given: bool) -> Result<()> {
         let mut away = Offenders::default();
         let mut covered = 0usize;
         for (i, ((n, v), &a)) in normals.iter().zip(views).zip(coverage).enumerate() {
@@ -303,10 +302,24 @@ impl Checker<'_> {
             counted(away.count, "pixel"),
             away.first_at(self.width)
         );
-        if away.count * 2 > covered {
-            return Err(self.error(format!(
-                "{summary}: V must point from the surface toward the eye; is it the camera ray reversed?"
-            )));
+        // A quarter facing away is no grazing edge: the file is wrong, and a half-black render
+        // must not pass. Say what would fix it.
+        if away.count * 4 > covered {
+            let share_away = |turn: &dyn Fn(Vec3, Vec3) -> (Vec3, Vec3)| {
+                let turned = normals.iter().zip(views).zip(coverage).filter(|(_, &a)| a > 0.0);
+                turned.filter(|((&n, &v), _)| turn(n, v).0.dot(turn(n, v).1) <= 0.0).count() as f32 / covered as f32
+            };
+            let z_up = |n: Vec3, v: Vec3| (Vec3::new(n.x, n.z, -n.y), v);
+            let y_up = |n: Vec3, v: Vec3| (Vec3::new(n.x, -n.z, n.y), v);
+            let fixed = |share: f32| format!("turned, {:.0}% would", share * 100.0);
+            let hint = if !view_given && share_away(&z_up) < 0.05 {
+                format!("the normals look Z-up ({} face away): pass --up z", fixed(share_away(&z_up)))
+            } else if !view_given && share_away(&y_up) < 0.05 {
+                format!("the normals look Y-up ({} face away): pass --up y", fixed(share_away(&y_up)))
+            } else {
+                "V must point from the surface toward the eye; is it the camera ray reversed?".to_string()
+            };
+            return Err(self.error(format!("{summary}: {hint}")));
         }
         self.warn(format!("{summary}; they shade black"));
         Ok(())
@@ -338,8 +351,8 @@ impl Checker<'_> {
     }
 
     /// Object IDs: uint samples as they are; half/float samples must hold non-negative integers.
-    fn object_ids(&self, samples: &FlatSamples) -> Result<Vec<u32>> {
-        if let FlatSamples::U32(ids) = samples {
+    fn object_ids(&self, samples: &Samples) -> Result<Vec<u32>> {
+        if let Samples::U32(ids) = samples {
             return Ok(ids.clone());
         }
         let mut bad = Offenders::default();
@@ -367,11 +380,7 @@ impl Checker<'_> {
     }
 
     /// Every `<prefix><name>` channel (masks, maps), keyed by `<name>`, each in \[0,1\].
-    fn prefixed(
-        &mut self,
-        channels: &BTreeMap<String, FlatSamples>,
-        prefix: &str,
-    ) -> Result<BTreeMap<String, Vec<f32>>> {
+    fn prefixed(&mut self, channels: &BTreeMap<String, Samples>, prefix: &str) -> Result<BTreeMap<String, Vec<f32>>> {
         let mut found = BTreeMap::new();
         for (channel, samples) in channels {
             let Some(name) = channel.strip_prefix(prefix).filter(|name| !name.is_empty()) else {
@@ -447,12 +456,8 @@ fn triple(raw: &RawImage, names: [&str; 3]) -> Vec<Vec3> {
     x.into_iter().zip(y).zip(z).map(|((x, y), z)| Vec3::new(x, y, z)).collect()
 }
 
-fn to_f32(samples: &FlatSamples) -> Vec<f32> {
-    match samples {
-        FlatSamples::F16(values) => values.iter().map(|v| v.to_f32()).collect(),
-        FlatSamples::F32(values) => values.clone(),
-        FlatSamples::U32(values) => values.iter().map(|&v| v as f32).collect(),
-    }
+fn to_f32(samples: &Samples) -> Vec<f32> {
+    samples.to_f32()
 }
 
 /// Whether the g-buffer reads this channel (the rest are ignored).
@@ -468,7 +473,7 @@ fn is_gbuffer_channel(name: &str) -> bool {
 mod tests {
     use super::*;
 
-    fn raw(width: usize, height: usize, channels: Vec<(&str, FlatSamples)>) -> RawImage {
+    fn raw(width: usize, height: usize, channels: Vec<(&str, Samples)>) -> RawImage {
         RawImage {
             width,
             height,
@@ -478,11 +483,11 @@ mod tests {
         }
     }
 
-    fn normals(pixels: usize) -> Vec<(&'static str, FlatSamples)> {
+    fn normals(pixels: usize) -> Vec<(&'static str, Samples)> {
         vec![
-            ("N.X", FlatSamples::F32(vec![0.0; pixels])),
-            ("N.Y", FlatSamples::F32(vec![0.0; pixels])),
-            ("N.Z", FlatSamples::F32(vec![1.0; pixels])),
+            ("N.X", Samples::F32(vec![0.0; pixels])),
+            ("N.Y", Samples::F32(vec![0.0; pixels])),
+            ("N.Z", Samples::F32(vec![1.0; pixels])),
         ]
     }
 
@@ -503,24 +508,24 @@ mod tests {
     #[test]
     fn subsampled_gbuffer_channels_are_refused_and_others_ignored() {
         let mut channels = normals(4);
-        channels.push(("mask.a", FlatSamples::F16(vec![half::f16::ZERO; 1])));
+        channels.push(("mask.a", Samples::F32(vec![0.0; 1])));
         let message = error_of(raw(2, 2, channels));
         assert!(message.contains("channel mask.a has 1 samples for 2x2 pixels"), "{message}");
 
         let mut channels = normals(4);
-        channels.push(("map.rough", FlatSamples::F16(vec![half::f16::ZERO; 2])));
+        channels.push(("map.rough", Samples::F32(vec![0.0; 2])));
         let message = error_of(raw(2, 2, channels));
         assert!(message.contains("channel map.rough has 2 samples for 2x2 pixels"), "{message}");
 
         let mut channels = normals(4);
-        channels.push(("RY", FlatSamples::F16(vec![half::f16::ZERO; 1])));
+        channels.push(("RY", Samples::F32(vec![0.0; 1])));
         assert!(build(Path::new("g.exr"), raw(2, 2, channels)).is_ok());
     }
 
     #[test]
     fn object_ids_beyond_u32_are_refused() {
         let mut channels = normals(2);
-        channels.push(("objectId", FlatSamples::F32(vec![7.0, 5e9])));
+        channels.push(("objectId", Samples::F32(vec![7.0, 5e9])));
         let message = error_of(raw(2, 1, channels));
         assert!(message.contains("objectId holds 1 value other than non-negative integers"), "{message}");
         assert!(message.contains("first at x=1, y=0"), "{message}");

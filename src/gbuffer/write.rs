@@ -104,7 +104,7 @@ fn half_channel(name: &str, values: &[f32]) -> AnyChannel<FlatSamples> {
     AnyChannel::new(text(name), FlatSamples::F16(values.iter().map(|&v| f16::from_f32(v)).collect()))
 }
 
-/// EXR text from UTF-8, byte for byte (what `read::text_to_string` decodes). The `exr` crate's
+/// EXR text from UTF-8, byte for byte (what `source::raw::text_to_string` decodes). The `exr` crate's
 /// own conversion panics on characters outside Latin-1.
 fn text(string: &str) -> Text {
     Text::from_slice_unchecked(string.as_bytes())
