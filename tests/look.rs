@@ -61,7 +61,7 @@ fn unknown_keys_name_the_table_and_the_expected_keys() {
     );
     assert_eq!(
         error("# a look\ncolour = 1\n"),
-        "looks/shot.toml:2: unknown key 'colour' at the top level (expected environment, render, model, object)"
+        "looks/shot.toml:2: unknown key 'colour' at the top level (expected environment, render, model, gbuffer, object)"
     );
     assert_eq!(
         error("[[object]]\nid = 1\n[[object.layer]]\npreset = \"gold\"\nmaks = \"stripes\"\n"),
@@ -69,8 +69,8 @@ fn unknown_keys_name_the_table_and_the_expected_keys() {
          set, map); did you mean 'mask'?"
     );
     assert_eq!(
-        error("[[object]]\nname = \"ball\"\n[[object.layer]]\n"),
-        "looks/shot.toml:2: unknown key 'name' in [[object]] (expected id, layer)"
+        error("[[object]]\nnmae = \"ball\"\n[[object.layer]]\n"),
+        "looks/shot.toml:2: unknown key 'nmae' in [[object]] (expected id, name, layer); did you mean 'name'?"
     );
 }
 
@@ -596,4 +596,58 @@ fn preset_complex_ior_must_match_its_base_color() {
         "presets/metal.toml:2: base_color[0] = 0.5 is not the F0 0.9626 of ior_n and ior_k (within 0.005)"
     );
     assert_eq!(bad("ior_n = [0, 1, 1]\nior_k = [0, 0, 0]\n"), "presets/metal.toml:1: ior_n[0] = 0 must be in (0, 100]");
+}
+
+#[test]
+fn gbuffer_tables_and_object_names_read_write_back_and_resolve() {
+    let text = "[gbuffer]\nfile = \"shot.exr\"\nlayer = \"ViewLayer\"\nup = \"z\"\ncamera_position = [0.5, -7.0, 2.5]\n\
+                normal = \"Nw\"\nposition = \"Pw\"\ncoverage = \"alpha\"\nid = \"objectIndex\"\nmasks = [\"matte_a\", \"matte_b\"]\n\n\
+                [[object]]\nname = \"Sphere.001\"\n[[object.layer]]\npreset = \"gold\"\n\n\
+                [[object]]\nid = 3\n[[object.layer]]\npreset = \"chrome\"\n";
+    let look = Look::parse(text, Path::new(SHOT)).unwrap();
+    let g = &look.gbuffer;
+    assert_eq!(g.file.as_deref(), Some(Path::new("looks/shot.exr")), "relative to the look");
+    assert_eq!(g.source.layer.as_deref(), Some("ViewLayer"));
+    assert_eq!(g.source.up, Some(lookdev::gbuffer::Up::Z));
+    assert_eq!(g.source.camera_position, Some(glam::Vec3::new(0.5, -7.0, 2.5)));
+    assert_eq!(g.source.channels.normal.as_deref(), Some("Nw"));
+    assert_eq!(g.source.channels.masks, ["matte_a", "matte_b"]);
+    assert_eq!((look.objects[0].name.as_deref(), look.objects[0].id), (Some("Sphere.001"), None));
+    assert!(!look.objects[0].is_default(), "a named stack is not the default stack");
+    let again = Look::parse(&look.to_toml(), Path::new(SHOT)).unwrap();
+    assert_eq!(again, look, "written back:\n{}", look.to_toml());
+
+    // Names resolve through the g-buffer's object names; an unknown one lists them.
+    let mut resolved = look.clone();
+    let names = std::collections::BTreeMap::from([(2, "Sphere.001".to_string()), (3, "Cube".to_string())]);
+    assert!(resolved.resolve_object_names(&names, Path::new("g.exr")).unwrap().is_empty());
+    assert_eq!(resolved.objects[0].id, Some(2));
+    assert!(resolved.to_toml().contains("name = \"Sphere.001\""), "the name is kept, not the id");
+    let claimed = std::collections::BTreeMap::from([(3, "Sphere.001".to_string())]);
+    let warnings = look.clone().resolve_object_names(&claimed, Path::new("g.exr")).unwrap();
+    assert_eq!(warnings.len(), 1);
+    assert!(
+        warnings[0].contains(
+            "looks/shot.toml:17: this stack claims object 3 'Sphere.001', which the stack at line 12 claims too"
+        ),
+        "{}",
+        warnings[0]
+    );
+    let unknown = look.clone().resolve_object_names(
+        &names.iter().filter(|(id, _)| **id == 3).map(|(k, v)| (*k, v.clone())).collect(),
+        Path::new("g.exr"),
+    );
+    let message = unknown.unwrap_err().to_string();
+    assert_eq!(message, "looks/shot.toml:12: no object named 'Sphere.001' in g.exr (it has Cube (3))");
+
+    assert_eq!(error("[gbuffer]\nup = \"x\"\n"), "looks/shot.toml:2: up = 'x': expected \"y\" or \"z\"");
+    assert_eq!(
+        error("[gbuffer]\ncamera_position = [1, 2]\n"),
+        "looks/shot.toml:2: camera_position must be a point [x, y, z], not an array"
+    );
+    assert!(error("[gbuffer]\nnormals = \"N\"\n").contains("unknown key 'normals' in [gbuffer]"));
+    assert_eq!(
+        error("[[object]]\nid = 2\nname = \"Cube\"\n[[object.layer]]\n"),
+        "looks/shot.toml:3: an [[object]] has an id or a name, not both"
+    );
 }

@@ -9,14 +9,14 @@
 
 mod common;
 
+use common::display::{xvfb, XServer};
 use image::RgbImage;
 use lookdev::gbuffer::GBuffer;
 use lookdev::material::look::Look;
 use lookdev::material::params::{Param, Value};
 use lookdev::viewer::thumbnails::{self, Thumbnails};
-use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 /// G-buffer size and window size: small enough for a CPU driver, with the image at 1:1.
@@ -44,41 +44,6 @@ mask = "stripes"
 [object.layer.set]
 roughness = 0.3
 "#;
-
-/// A virtual X server for one test, stopped when dropped.
-struct XServer {
-    child: Child,
-    display: String,
-}
-
-impl Drop for XServer {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-/// Starts Xvfb on a free display, or returns None (after saying why) where it is not installed.
-fn xvfb() -> Option<XServer> {
-    let spawned = Command::new("Xvfb")
-        .args(["-displayfd", "1", "-screen", "0", "1280x800x24", "-nolisten", "tcp"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn();
-    let mut child = match spawned {
-        Ok(child) => child,
-        Err(e) => {
-            assert!(std::env::var_os("CI").is_none(), "Xvfb is needed for the viewer tests in CI ({e})");
-            eprintln!("Xvfb is not installed (apt-get install xvfb): viewer test skipped");
-            return None;
-        }
-    };
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
-    let number = line.trim();
-    assert!(!number.is_empty(), "Xvfb did not report its display");
-    Some(XServer { child, display: format!(":{number}") })
-}
 
 /// A folder of inputs and outputs, and a display to open windows on.
 struct Case {
@@ -407,7 +372,10 @@ fn a_click_inspects_the_pixel_and_selects_its_object() {
     // The ball pixel: its object, its mask, the gold layer's weight, the blend, the radiance.
     let line = picks[0];
     let m = stripes[ball];
-    assert!(line.contains(&format!("pixel {}: object 1, coverage 1.0000", xy(ball).replace(' ', ","))), "{line}");
+    assert!(
+        line.contains(&format!("pixel {}: object 1 'ball', coverage 1.0000", xy(ball).replace(' ', ","))),
+        "{line}"
+    );
     assert!(line.contains(&format!("mask.stripes {m:.4}")), "{line}");
     assert!(line.contains(&format!("[1 gold blend {m:.4} share {m:.4}]")), "{line}");
     assert!(line.contains(&format!("[0 blue-rubber blend 1.0000 share {:.4}]", 1.0 - m)), "{line}");

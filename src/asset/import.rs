@@ -93,7 +93,8 @@ impl Import {
             environment: EnvironmentSettings::default(),
             render: RenderSettings::default(),
             model: None,
-            objects: vec![ObjectStack { id: None, layers }],
+            gbuffer: Default::default(),
+            objects: vec![ObjectStack::new(None, layers)],
         }
     }
 

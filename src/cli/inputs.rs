@@ -1,13 +1,65 @@
-//! The flags every rendering command shares: lighting, sampling, display, and `--set`.
+//! The flags every rendering command shares: the g-buffer, lighting, sampling, display, and
+//! `--set`.
 
 use crate::environment::{self, Environment, LoadOptions};
+use crate::gbuffer::source::{Channels, SourceOptions, Up};
 use crate::gbuffer::GBuffer;
 use crate::material::{Look, Param, Value};
+use crate::render::scene::GBufferSpec;
 use crate::render::settings::{Overrides, Settings};
 use crate::render::tonemap::Tonemap;
-use crate::Result;
+use crate::{Error, Result};
 use clap::Args;
 use std::path::PathBuf;
+
+/// The g-buffer and how to read it (docs/formats.md: Production renders).
+#[derive(Args, Debug, Default, Clone)]
+pub struct GBufferArgs {
+    /// The g-buffer EXR to relight: lookdev's own, a Blender/Cycles multilayer EXR or Arnold-style
+    /// AOVs (default: the look's [gbuffer] file, else the built-in shader ball, 1024x1024).
+    #[arg(long, value_name = "FILE.exr")]
+    pub gbuffer: Option<PathBuf>,
+    /// The Blender view layer, or the part of a multi-part EXR, to read.
+    #[arg(long, value_name = "NAME")]
+    pub gbuffer_layer: Option<String>,
+    /// The g-buffer's up axis: y (lookdev, Maya, Houdini, Arnold) or z (Blender); default: the
+    /// source's own.
+    #[arg(long, value_name = "y|z", value_parser = Up::parse)]
+    pub up: Option<Up>,
+    /// Where the camera was, in the g-buffer's own coordinates, for view vectors from positions
+    /// when the file does not record it.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = parse_point)]
+    pub camera_position: Option<glam::Vec3>,
+    /// Where one of lookdev's channels comes from in the g-buffer: ROLE is normal, position,
+    /// view, tangent (layer names), coverage, id or mask (channel names), e.g.
+    /// --gbuffer-channel normal=N_world. Repeatable; mask adds one each time.
+    #[arg(long = "gbuffer-channel", value_name = "ROLE=NAME")]
+    pub channels: Vec<String>,
+}
+
+fn parse_point(text: &str) -> std::result::Result<glam::Vec3, String> {
+    crate::gbuffer::source::camera::parse_vector(text).ok_or_else(|| format!("'{text}' is not three numbers X,Y,Z"))
+}
+
+impl GBufferArgs {
+    /// The g-buffer file and how to read it, as the flags say.
+    pub fn spec(&self) -> Result<GBufferSpec> {
+        let mut channels = Channels::default();
+        for text in &self.channels {
+            let (role, name) = text.split_once('=').ok_or_else(|| {
+                Error::input(format!("--gbuffer-channel {text}: expected ROLE=NAME, e.g. normal=N_world"))
+            })?;
+            channels.set(role.trim(), name).map_err(|e| Error::input(format!("--gbuffer-channel {text}: {e}")))?;
+        }
+        let source = SourceOptions {
+            layer: self.gbuffer_layer.clone(),
+            up: self.up,
+            camera_position: self.camera_position,
+            channels,
+        };
+        Ok(GBufferSpec { file: self.gbuffer.clone(), source })
+    }
+}
 
 /// The environment and how it lights the scene.
 #[derive(Args, Debug, Default)]

@@ -24,9 +24,10 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct LintArgs {
     pub look: PathBuf,
-    /// Check the look's masks and maps against this g-buffer, and the bound layers at its pixels.
-    #[arg(long, value_name = "FILE.exr")]
-    pub gbuffer: Option<PathBuf>,
+    /// With a g-buffer (--gbuffer, or the look's [gbuffer] file): check the look's masks, maps
+    /// and object names against it, and the bound layers at its pixels.
+    #[command(flatten)]
+    pub input: super::inputs::GBufferArgs,
 }
 
 /// The rules, each reading some parameters.
@@ -110,19 +111,45 @@ pub fn findings(params: &Params) -> Vec<(Rule, String)> {
 pub const PIXEL_SHARE: f32 = 0.01;
 
 pub fn run(args: LintArgs) -> Result<()> {
-    let look = Look::load(&args.look)?;
-    let gbuffer = match &args.gbuffer {
-        Some(path) => {
-            let gbuffer = GBuffer::read(path)?;
-            // The masks and maps must be there, as for a render.
-            PackedStacks::pack(&look, covered_object_ids(&gbuffer), &gbuffer, path)?;
-            Some(gbuffer)
-        }
-        None => None,
-    };
+    let mut look = Look::load(&args.look)?;
+    let spec = args.input.spec()?;
     let mut count = 0;
+    let gbuffer = match spec.file.is_some() || look.gbuffer.file.is_some() {
+        true => {
+            // Stacks that claim the same object are findings here, not warnings.
+            let file = spec.file.clone().or_else(|| look.gbuffer.file.clone()).expect("checked");
+            let read = GBuffer::read_with(&file, &spec.source.over(&look.gbuffer.source))?;
+            read.warnings.into_iter().for_each(crate::warn);
+            for claim in look.resolve_object_names(&read.gbuffer.object_names, &file)? {
+                println!("{claim}");
+                count += 1;
+            }
+            // The masks and maps must be there, as for a render.
+            PackedStacks::pack(&look, covered_object_ids(&read.gbuffer), &read.gbuffer, &file)?;
+            Some(read.gbuffer)
+        }
+        false => {
+            for (i, stack) in look.objects.iter().enumerate() {
+                let Some(name) = &stack.name else { continue };
+                if let Some(first) = look.objects[..i].iter().find(|o| o.name.as_ref() == Some(name)) {
+                    println!(
+                        "{}:{}: this stack claims object '{name}', which the stack at line {} claims too",
+                        args.look.display(),
+                        stack.line,
+                        first.line
+                    );
+                    count += 1;
+                }
+            }
+            None
+        }
+    };
     for object in &look.objects {
-        let who = object.id.map(|id| format!("object {id}")).unwrap_or_else(|| "default stack".into());
+        let who = match (&object.name, object.id) {
+            (Some(name), _) => format!("object '{name}'"),
+            (None, Some(id)) => format!("object {id}"),
+            (None, None) => "default stack".into(),
+        };
         for (i, layer) in object.layers.iter().enumerate() {
             let name = layer.preset.as_deref().map(|p| format!(" ({p})")).unwrap_or_default();
             let mut report = |finding: String| {
@@ -160,7 +187,7 @@ fn pixel_findings(
 ) -> Vec<String> {
     // A look of this one layer alone, filling, resolves its own material at each pixel.
     let lone = Look {
-        objects: vec![ObjectStack { id: None, layers: vec![Layer { mask: None, ..stack.layers[index].clone() }] }],
+        objects: vec![ObjectStack::new(None, vec![Layer { mask: None, ..stack.layers[index].clone() }])],
         ..look.clone()
     };
     let Ok(packed) = PackedStacks::pack(&lone, covered_object_ids(gbuffer), gbuffer, std::path::Path::new("")) else {

@@ -1,6 +1,6 @@
 //! `lookdev render`.
 
-use super::inputs::{self, DisplayArgs, LightingArgs, SamplingArgs};
+use super::inputs::{self, DisplayArgs, GBufferArgs, LightingArgs, SamplingArgs};
 use super::progress::Progress;
 use crate::gpu::Context;
 use crate::render::compare::{self, Summary};
@@ -16,9 +16,8 @@ use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// The g-buffer EXR to relight (default: the built-in shader ball, 1024x1024).
-    #[arg(long, value_name = "FILE.exr")]
-    pub gbuffer: Option<PathBuf>,
+    #[command(flatten)]
+    pub input: GBufferArgs,
     /// The look: layer stacks, environment and render settings.
     #[arg(long, value_name = "FILE.toml")]
     pub look: Option<PathBuf>,
@@ -87,8 +86,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     let overrides = inputs::overrides(&args.lighting, &args.sampling, &args.display);
     let sets = inputs::parse_sets(&args.set)?;
+    let gbuffer = args.input.spec()?;
     let load = |look: Option<&Path>, overrides: &Overrides| {
-        Scene::load(args.gbuffer.as_deref(), look, &sets, overrides, &args.lighting.load_options())
+        Scene::load(&gbuffer, look, &sets, overrides, &args.lighting.load_options(), args.quiet)
     };
     if let Some(second) = &args.compare {
         return run_compare(&args, format, second.as_deref(), &overrides, load);
@@ -139,7 +139,7 @@ fn run_compare(
 ) -> Result<()> {
     let look_name = |look: Option<&Path>| match look.and_then(Path::file_name) {
         Some(name) => name.to_string_lossy().into_owned(),
-        None if args.gbuffer.is_none() => "built-in look".to_string(),
+        None if args.input.gbuffer.is_none() => "built-in look".to_string(),
         None => "default material".to_string(),
     };
     // B is either a second look, read on its own, or A's scene with another model: then the

@@ -5,7 +5,7 @@
 //! different machines with the same device and driver (and any `--range` split) match a single
 //! run bit for bit.
 
-use super::inputs::{self, DisplayArgs, LightingArgs, SamplingArgs};
+use super::inputs::{self, DisplayArgs, GBufferArgs, LightingArgs, SamplingArgs};
 use super::progress::Progress;
 use crate::render::batch::Batch;
 use crate::render::output::{self, OutputFormat};
@@ -18,8 +18,8 @@ use std::path::{Path, PathBuf};
 pub struct TurntableArgs {
     #[arg(long, value_name = "FILE.toml")]
     pub look: Option<PathBuf>,
-    #[arg(long, value_name = "FILE.exr")]
-    pub gbuffer: Option<PathBuf>,
+    #[command(flatten)]
+    pub input: GBufferArgs,
     /// Override a parameter on every layer of every object, e.g. --set metallic=1.
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
@@ -98,8 +98,14 @@ pub fn run(args: TurntableArgs) -> Result<()> {
     }
     let overrides = inputs::overrides(&args.lighting, &args.sampling, &args.display);
     let sets = inputs::parse_sets(&args.set)?;
-    let scene =
-        Scene::load(args.gbuffer.as_deref(), args.look.as_deref(), &sets, &overrides, &args.lighting.load_options())?;
+    let scene = Scene::load(
+        &args.input.spec()?,
+        args.look.as_deref(),
+        &sets,
+        &overrides,
+        &args.lighting.load_options(),
+        args.quiet,
+    )?;
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
     scene.check_device(ctx.info())?;

@@ -1,6 +1,6 @@
 //! `lookdev view`: the interactive viewer.
 
-use super::inputs::{self, DisplayArgs, LightingArgs, SamplingArgs};
+use super::inputs::{self, DisplayArgs, GBufferArgs, LightingArgs, SamplingArgs};
 use crate::{Error, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -11,9 +11,8 @@ pub struct ViewArgs {
     /// default material on a g-buffer).
     #[arg(value_name = "LOOK.toml")]
     pub look: Option<PathBuf>,
-    /// The g-buffer EXR to relight (default: the built-in shader ball, 1024x1024).
-    #[arg(long, value_name = "FILE.exr")]
-    pub gbuffer: Option<PathBuf>,
+    #[command(flatten)]
+    pub input: GBufferArgs,
     /// Override a parameter on every layer of every object when the look opens.
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
@@ -90,7 +89,7 @@ fn open(
     crate::viewer::run(crate::viewer::ViewOptions {
         env_options: args.lighting.load_options(),
         look: args.look,
-        gbuffer: args.gbuffer,
+        gbuffer: args.input.spec()?,
         sets,
         overrides,
         device: args.device,

@@ -49,6 +49,7 @@ use serde::Deserialize;
 use super::library::Library;
 use super::params::{Param, Params, Value};
 use super::toml_input::{self as input, Field, Source};
+use crate::gbuffer::source::{Channels, SourceOptions, Up};
 use crate::render::settings::MAX_EXPOSURE;
 use crate::render::tonemap::Tonemap;
 use crate::shading::model::{Model, ModelValue};
@@ -64,8 +65,18 @@ pub struct Look {
     pub render: RenderSettings,
     /// From `[model]`: the BRDF model, `None` when the look has no such table (the default).
     pub model: Option<Model>,
+    /// From `[gbuffer]`: the g-buffer and how to read it; flags override it.
+    pub gbuffer: GBufferSettings,
     /// From `[[object]]`, in file order.
     pub objects: Vec<ObjectStack>,
+}
+
+/// `[gbuffer]`: the g-buffer file (resolved against the look file's folder) and how to read
+/// it (docs/formats.md: Production renders).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GBufferSettings {
+    pub file: Option<PathBuf>,
+    pub source: SourceOptions,
 }
 
 /// `[environment]`. `None` means "not set here": the caller's default applies.
@@ -93,12 +104,43 @@ pub struct RenderSettings {
 }
 
 /// One `[[object]]`: the layer stack for an object id, or the default stack.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct ObjectStack {
-    /// `None` is the default stack, used by every object without a stack of its own.
+    /// The object's id: as written, or resolved from `name` once the g-buffer is read. `None`
+    /// with no `name` is the default stack, used by every object without a stack of its own.
     pub id: Option<u32>,
+    /// The object's name, as the g-buffer names it (`name = "Sphere.001"`), instead of `id`.
+    pub name: Option<String>,
     /// Bottom layer first. Never empty.
     pub layers: Vec<Layer>,
+    /// The 1-based line of this `[[object]]` in the file, for later error messages.
+    pub line: usize,
+}
+
+impl PartialEq for ObjectStack {
+    fn eq(&self, other: &ObjectStack) -> bool {
+        self.id == other.id && self.name == other.name && self.layers == other.layers
+    }
+}
+
+impl ObjectStack {
+    /// A stack for an object id (`None`: the default stack).
+    pub fn new(id: Option<u32>, layers: Vec<Layer>) -> ObjectStack {
+        ObjectStack { id, name: None, layers, line: 0 }
+    }
+
+    /// Whether this is the default stack: neither an id nor a name.
+    pub fn is_default(&self) -> bool {
+        self.id.is_none() && self.name.is_none()
+    }
+
+    /// Whether this is the stack of `id`, or, for `None`, the default stack.
+    pub fn is_for(&self, id: Option<u32>) -> bool {
+        match id {
+            Some(_) => self.id == id,
+            None => self.is_default(),
+        }
+    }
 }
 
 /// One `[[object.layer]]`: a preset, overrides, and the mask that blends it over the layers
@@ -196,6 +238,7 @@ impl Look {
             environment: EnvironmentSettings::default(),
             render: RenderSettings::default(),
             model: None,
+            gbuffer: GBufferSettings::default(),
             objects: Vec::new(),
         };
         look.ensure_default_stack();
@@ -205,17 +248,59 @@ impl Look {
     /// Gives a look without a default stack one of a single default-material layer, so every
     /// object has a stack that `--set` can reach. Returns whether it added one.
     pub fn ensure_default_stack(&mut self) -> bool {
-        if self.objects.iter().any(|o| o.id.is_none()) {
+        if self.objects.iter().any(ObjectStack::is_default) {
             return false;
         }
-        self.objects.push(ObjectStack { id: None, layers: vec![Layer::filling(Params::default())] });
+        self.objects.push(ObjectStack::new(None, vec![Layer::filling(Params::default())]));
         true
     }
 
     /// The stack for an object id: its own, else the default stack, else `None`.
     pub fn stack_for(&self, id: u32) -> Option<&ObjectStack> {
         let own = self.objects.iter().find(|o| o.id == Some(id));
-        own.or_else(|| self.objects.iter().find(|o| o.id.is_none()))
+        own.or_else(|| self.objects.iter().find(|o| o.is_default()))
+    }
+
+    /// Gives each stack that names its object (`name = "..."`) that object's id, from the
+    /// g-buffer's object names. An unknown name is an error at the stack's line, listing the
+    /// names the g-buffer has. Returns a warning for each stack that claims an object an earlier
+    /// one claims (the earlier one is used).
+    pub fn resolve_object_names(
+        &mut self,
+        names: &BTreeMap<u32, String>,
+        gbuffer: &Path,
+    ) -> crate::Result<Vec<String>> {
+        let file = self.file.clone().unwrap_or_else(|| PathBuf::from("<look>"));
+        for stack in self.objects.iter_mut() {
+            let Some(name) = &stack.name else { continue };
+            let id = names.iter().find(|(_, n)| *n == name).map(|(&id, _)| id).ok_or_else(|| {
+                let listed: Vec<String> = names.iter().map(|(id, n)| format!("{n} ({id})")).collect();
+                let has = if listed.is_empty() { "no object names".to_string() } else { listed.join(", ") };
+                crate::Error::input_file(
+                    format!("{}:{}", file.display(), stack.line),
+                    format!("no object named '{name}' in {} (it has {has})", gbuffer.display()),
+                )
+            })?;
+            stack.id = Some(id);
+        }
+        Ok(self.claim_warnings(names))
+    }
+
+    /// A warning for each stack that claims an object an earlier stack claims, by id or name.
+    pub fn claim_warnings(&self, names: &BTreeMap<u32, String>) -> Vec<String> {
+        let file = self.file.as_deref().unwrap_or(Path::new("<look>")).display().to_string();
+        let mut warnings = Vec::new();
+        for (i, stack) in self.objects.iter().enumerate() {
+            let Some(id) = stack.id else { continue };
+            if let Some(first) = self.objects[..i].iter().find(|o| o.id == Some(id)) {
+                let name = names.get(&id).map(|n| format!(" '{n}'")).unwrap_or_default();
+                warnings.push(format!(
+                    "{file}:{}: this stack claims object {id}{name}, which the stack at line {} claims too; that one is used",
+                    stack.line, first.line
+                ));
+            }
+        }
+        warnings
     }
 
     /// Applies `--set NAME=VALUE` to every layer of every object, after the look's own values,
@@ -240,6 +325,7 @@ impl Look {
         let mut lines = Vec::new();
         self.write_environment(&mut lines);
         self.write_render(&mut lines);
+        self.write_gbuffer(&mut lines);
         if let Some(model) = &self.model {
             let body = model.entries().into_iter().map(|(k, v)| format!("{k} = {v}")).collect();
             push_section(&mut lines, "[model]", body);
@@ -266,6 +352,49 @@ impl Look {
         push_section(lines, "[environment]", body);
     }
 
+    fn write_gbuffer(&self, lines: &mut Vec<String>) {
+        let settings = &self.gbuffer;
+        let source = &settings.source;
+        let mut body = Vec::new();
+        if let Some(file) = &settings.file {
+            let folder = self.file.as_deref().and_then(Path::parent).unwrap_or(Path::new(""));
+            let relative = file.strip_prefix(folder).unwrap_or(file);
+            body.push(format!("file = {}", input::quoted(&relative.to_string_lossy())));
+        }
+        if let Some(layer) = &source.layer {
+            body.push(format!("layer = {}", input::quoted(layer)));
+        }
+        if let Some(up) = source.up {
+            body.push(format!("up = {}", input::quoted(up.name())));
+        }
+        if let Some(p) = source.camera_position {
+            body.push(format!(
+                "camera_position = [{}, {}, {}]",
+                input::float(p.x),
+                input::float(p.y),
+                input::float(p.z)
+            ));
+        }
+        let c = &source.channels;
+        for (key, value) in [
+            ("normal", &c.normal),
+            ("position", &c.position),
+            ("view", &c.view),
+            ("tangent", &c.tangent),
+            ("coverage", &c.coverage),
+            ("id", &c.id),
+        ] {
+            if let Some(value) = value {
+                body.push(format!("{key} = {}", input::quoted(value)));
+            }
+        }
+        if !c.masks.is_empty() {
+            let masks: Vec<String> = c.masks.iter().map(|m| input::quoted(m)).collect();
+            body.push(format!("masks = [{}]", masks.join(", ")));
+        }
+        push_section(lines, "[gbuffer]", body);
+    }
+
     fn write_render(&self, lines: &mut Vec<String>) {
         let render = &self.render;
         let mut body = Vec::new();
@@ -286,8 +415,10 @@ impl Look {
 impl ObjectStack {
     fn write(&self, lines: &mut Vec<String>) {
         lines.push("[[object]]".to_string());
-        if let Some(id) = self.id {
-            lines.push(format!("id = {id}"));
+        match (&self.name, self.id) {
+            (Some(name), _) => lines.push(format!("name = {}", input::quoted(name))),
+            (None, Some(id)) => lines.push(format!("id = {id}")),
+            (None, None) => {}
         }
         for layer in &self.layers {
             layer.write(lines);
@@ -353,8 +484,25 @@ struct LookFile {
     render: Option<RenderFile>,
     /// Keys are checked by `Model::set`, which names the values each takes.
     model: Option<BTreeMap<Field<String>, Field>>,
+    gbuffer: Option<GBufferFile>,
     #[serde(default)]
     object: Vec<Field<ObjectFile>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a [gbuffer] table")]
+struct GBufferFile {
+    file: Option<Field>,
+    layer: Option<Field>,
+    up: Option<Field>,
+    camera_position: Option<Field>,
+    normal: Option<Field>,
+    position: Option<Field>,
+    view: Option<Field>,
+    tangent: Option<Field>,
+    coverage: Option<Field>,
+    id: Option<Field>,
+    masks: Option<Field>,
 }
 
 #[derive(Deserialize)]
@@ -379,6 +527,7 @@ struct RenderFile {
 #[serde(deny_unknown_fields, expecting = "an [[object]] table")]
 struct ObjectFile {
     id: Option<Field>,
+    name: Option<Field>,
     #[serde(default)]
     layer: Vec<Field<LayerFile>>,
 }
@@ -406,6 +555,7 @@ fn parse_with(src: Source, library: &Library) -> crate::Result<Look> {
         environment: environment(&src, raw.environment, folder)?,
         render: render(&src, raw.render)?,
         model: model(&src, raw.model.as_ref())?,
+        gbuffer: gbuffer(&src, raw.gbuffer, folder)?,
         objects: objects(&src, &raw.object, library)?,
     };
     warn_about_bottom_layers(&src, &look);
@@ -422,6 +572,46 @@ fn environment(src: &Source, raw: Option<EnvironmentFile>, folder: &Path) -> cra
         intensity: src.read("intensity", &raw.intensity, intensity)?,
         background: src.read("background", &raw.background, input::boolean)?,
     })
+}
+
+fn gbuffer(src: &Source, raw: Option<GBufferFile>, folder: &Path) -> crate::Result<GBufferSettings> {
+    let Some(raw) = raw else {
+        return Ok(GBufferSettings::default());
+    };
+    let text = |key: &str, field: &Option<Field>| src.read(key, field, input::text);
+    let channels = Channels {
+        normal: text("normal", &raw.normal)?,
+        position: text("position", &raw.position)?,
+        view: text("view", &raw.view)?,
+        tangent: text("tangent", &raw.tangent)?,
+        coverage: text("coverage", &raw.coverage)?,
+        id: text("id", &raw.id)?,
+        masks: src.read("masks", &raw.masks, input::text_list)?.unwrap_or_default(),
+    };
+    let camera_position = src.read("camera_position", &raw.camera_position, point)?;
+    Ok(GBufferSettings {
+        file: text("file", &raw.file)?.map(|f| folder.join(f)),
+        source: SourceOptions {
+            layer: text("layer", &raw.layer)?,
+            up: src.read("up", &raw.up, |key, value| Up::parse(&input::text(key, value)?))?,
+            camera_position,
+            channels,
+        },
+    })
+}
+
+/// Three finite numbers `[x, y, z]`.
+fn point(key: &str, value: &toml::Value) -> Result<glam::Vec3, String> {
+    match value {
+        toml::Value::Array(items) if items.len() == 3 => {
+            let mut xyz = [0.0; 3];
+            for (i, item) in items.iter().enumerate() {
+                xyz[i] = input::number(&format!("{key}[{i}]"), item)?;
+            }
+            Ok(glam::Vec3::from(xyz))
+        }
+        _ => Err(format!("{key} must be a point [x, y, z], not {}", input::describe(value))),
+    }
 }
 
 fn render(src: &Source, raw: Option<RenderFile>) -> crate::Result<RenderSettings> {
@@ -469,6 +659,19 @@ fn objects(src: &Source, raw: &[Field<ObjectFile>], library: &Library) -> crate:
     for object in raw {
         let line = src.line(object.span().start);
         let id = src.read("id", &object.get_ref().id, |k, v| input::unsigned(k, v, 0))?;
+        let name = src.read("name", &object.get_ref().name, input::text)?;
+        if let (Some(_), Some(field)) = (id, &object.get_ref().name) {
+            return Err(src.error(field.span(), "an [[object]] has an id or a name, not both"));
+        }
+        if name.is_some() {
+            let layers = &object.get_ref().layer;
+            if layers.is_empty() {
+                return Err(src.error(object.span(), "[[object]] has no layers; add at least one [[object.layer]]"));
+            }
+            let layers = layers.iter().map(|l| layer(src, l, library)).collect::<crate::Result<_>>()?;
+            stacks.push(ObjectStack { id: None, name, layers, line });
+            continue;
+        }
         if let Some(first) = first_line.insert(id, line) {
             let problem = match id {
                 Some(id) => format!("duplicate object id {id} (first at line {first})"),
@@ -481,7 +684,7 @@ fn objects(src: &Source, raw: &[Field<ObjectFile>], library: &Library) -> crate:
             return Err(src.error(object.span(), "[[object]] has no layers; add at least one [[object.layer]]"));
         }
         let layers = layers.iter().map(|l| layer(src, l, library)).collect::<crate::Result<_>>()?;
-        stacks.push(ObjectStack { id, layers });
+        stacks.push(ObjectStack { id, name: None, layers, line });
     }
     Ok(stacks)
 }

@@ -329,7 +329,7 @@ mod tests {
 
     fn look(layers: Vec<Layer>) -> Look {
         let mut look = Look::default_material();
-        look.objects = vec![ObjectStack { id: Some(1), layers }];
+        look.objects = vec![ObjectStack::new(Some(1), layers)];
         look
     }
 
@@ -423,7 +423,7 @@ mod tests {
             vec![layer(0.1, None, true), layer(0.5, Some("stripes"), true), layer(0.9, Some("grunge"), true)];
         layers[2].invert = true;
         layers.insert(1, layer(0.7, None, false));
-        let stack = ObjectStack { id: Some(1), layers: layers.clone() };
+        let stack = ObjectStack::new(Some(1), layers.clone());
         let masks = |name: &str| if name == "stripes" { 0.8 } else { 0.25 };
         let weights = layer_weights(&stack, masks);
         assert_eq!(weights[1], None, "a disabled layer has no weight");

@@ -68,8 +68,8 @@ pub fn preset_on_ball(params: &Params) -> Look {
     let pedestal = Params { base_color: [0.18; 3], roughness: 0.6, ..Params::default() };
     let mut look = Look::default_material();
     look.objects = vec![
-        ObjectStack { id: None, layers: vec![Layer::filling(pedestal)] },
-        ObjectStack { id: Some(crate::gbuffer::BALL_ID), layers: vec![Layer::filling(*params)] },
+        ObjectStack::new(None, vec![Layer::filling(pedestal)]),
+        ObjectStack::new(Some(crate::gbuffer::BALL_ID), vec![Layer::filling(*params)]),
     ];
     look
 }

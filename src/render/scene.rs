@@ -2,6 +2,7 @@
 //! its stacks packed for the objects present), environment and settings.
 
 use crate::environment::{self, Environment, LoadOptions};
+use crate::gbuffer::source::{Source, SourceOptions};
 use crate::gbuffer::GBuffer;
 use crate::material::stack::{unused_stack_warnings, PackedStacks};
 use crate::material::{Look, Param, Value};
@@ -45,15 +46,16 @@ impl Scene {
     /// built-in default look for the shader ball, or the default material for a user g-buffer.
     /// `sets` override parameters on every layer; `overrides` the look's settings.
     pub fn load(
-        gbuffer: Option<&Path>,
+        gbuffer: &GBufferSpec,
         look: Option<&Path>,
         sets: &[(Param, Value)],
         overrides: &Overrides,
         env_options: &LoadOptions,
+        quiet: bool,
     ) -> Result<Scene> {
         let mut look = match look {
             Some(path) => Look::load(path)?,
-            None if gbuffer.is_none() => Look::builtin_default(),
+            None if gbuffer.file.is_none() => Look::builtin_default(),
             None => Look::default_material(),
         };
         let had_stacks = !look.objects.is_empty();
@@ -66,10 +68,7 @@ impl Scene {
             Some(path) => environment::load::load(path, env_options)?,
             None => Environment::studio(),
         };
-        let (gbuffer, gbuffer_name) = match gbuffer {
-            Some(path) => (GBuffer::read(path)?, path.to_path_buf()),
-            None => (GBuffer::shaderball(BUILTIN_SIZE, BUILTIN_SIZE), PathBuf::from("built-in shader ball")),
-        };
+        let (gbuffer, gbuffer_name) = read_gbuffer(gbuffer, &mut look, quiet)?;
         if implicit_default && had_stacks {
             let unstyled: Vec<String> = covered_object_ids(&gbuffer)
                 .into_iter()
@@ -108,6 +107,35 @@ impl Scene {
         }
         Ok(())
     }
+}
+
+/// The g-buffer to render and how to read it, as the command line gives them; the look's
+/// `[gbuffer]` table fills in what they leave out.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GBufferSpec {
+    pub file: Option<PathBuf>,
+    pub source: SourceOptions,
+}
+
+/// Reads the g-buffer `spec` and the look's `[gbuffer]` table name (the built-in shader ball
+/// when neither names one), prints what its file was detected as (unless `quiet`) and its
+/// warnings, and gives the look's stacks that name their objects those objects' ids. Returns the
+/// g-buffer and its name for messages.
+pub fn read_gbuffer(spec: &GBufferSpec, look: &mut Look, quiet: bool) -> Result<(GBuffer, PathBuf)> {
+    let file = spec.file.clone().or_else(|| look.gbuffer.file.clone());
+    let (gbuffer, name) = match file {
+        Some(path) => {
+            let read = GBuffer::read_with(&path, &spec.source.over(&look.gbuffer.source))?;
+            if !quiet && read.detected.source != Source::Lookdev {
+                eprintln!("lookdev: {}", crate::printable(&read.detected.summary(&path)));
+            }
+            read.warnings.into_iter().for_each(crate::warn);
+            (read.gbuffer, path)
+        }
+        None => (GBuffer::shaderball(BUILTIN_SIZE, BUILTIN_SIZE), PathBuf::from("built-in shader ball")),
+    };
+    look.resolve_object_names(&gbuffer.object_names, &name)?.into_iter().for_each(crate::warn);
+    Ok((gbuffer, name))
 }
 
 /// What makes a valid render come out black, or show only the background, each as a warning

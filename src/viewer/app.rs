@@ -17,7 +17,7 @@ use crate::gpu::context::{Presentation, ValidationCounter};
 use crate::gpu::{Context, ContextOptions};
 use crate::material::stack::{unused_stack_warnings, PackedStacks};
 use crate::material::Look;
-use crate::render::scene::{covered_object_ids, dark_render_warnings, BUILTIN_SIZE};
+use crate::render::scene::{covered_object_ids, dark_render_warnings, read_gbuffer};
 use crate::render::settings::{Overrides, Settings};
 use crate::viewer_state::{Document, Edit, ObjectRef, Selection};
 use crate::{Error, Result};
@@ -59,7 +59,7 @@ impl Inputs {
     fn load(options: &ViewOptions) -> Result<Inputs> {
         let mut look = match &options.look {
             Some(path) => Look::load(path)?,
-            None if options.gbuffer.is_none() => Look::builtin_default(),
+            None if options.gbuffer.file.is_none() => Look::builtin_default(),
             None => Look::default_material(),
         };
         for (param, value) in &options.sets {
@@ -70,10 +70,7 @@ impl Inputs {
             Some(path) => environment::load::load(path, &options.env_options)?,
             None => Environment::studio(),
         };
-        let (gbuffer, gbuffer_name) = match &options.gbuffer {
-            Some(path) => (GBuffer::read(path)?, path.clone()),
-            None => (GBuffer::shaderball(BUILTIN_SIZE, BUILTIN_SIZE), PathBuf::from("built-in shader ball")),
-        };
+        let (gbuffer, gbuffer_name) = read_gbuffer(&options.gbuffer, &mut look, false)?;
         let covered = covered_object_ids(&gbuffer);
         PackedStacks::pack(&look, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
         unused_stack_warnings(&look, &covered, &gbuffer_name).into_iter().for_each(crate::warn);
@@ -83,7 +80,8 @@ impl Inputs {
         // B's inputs are checked here too, so that a bad one is an error before a window opens.
         model_with(settings.model, &options.compare_model, "--compare-model")?;
         if let Some(path) = &options.compare_look {
-            let b = Look::load(path)?;
+            let mut b = Look::load(path)?;
+            b.resolve_object_names(&gbuffer.object_names, &gbuffer_name)?;
             PackedStacks::pack(&b, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
         }
         let mut document = Document::new(look, options.look.clone(), settings);
@@ -542,9 +540,10 @@ impl Running {
     }
 
     fn open_look(&mut self, path: &Path) -> Result<Option<String>> {
-        let look = Look::load(path)?;
+        let mut look = Look::load(path)?;
+        let mut warnings = look.resolve_object_names(&self.session.gbuffer.object_names, &self.session.gbuffer_name)?;
         let settings = Settings::resolve(&look, &Overrides::default())?;
-        let warnings = unused_stack_warnings(&look, self.session.objects(), &self.session.gbuffer_name);
+        warnings.extend(unused_stack_warnings(&look, self.session.objects(), &self.session.gbuffer_name));
         let mut document = Document::new(look, Some(path.to_path_buf()), settings);
         document.select(initial_selection(&document, self.session.objects()));
         self.session.replace_document(document)?;

@@ -24,6 +24,7 @@ pub use script::{Script, Step};
 
 use crate::environment::LoadOptions;
 use crate::material::{Param, Value};
+use crate::render::scene::GBufferSpec;
 use crate::render::settings::Overrides;
 use crate::{Error, Result};
 use std::path::PathBuf;
@@ -32,7 +33,7 @@ use std::path::PathBuf;
 #[derive(Clone, Debug, Default)]
 pub struct ViewOptions {
     pub look: Option<PathBuf>,
-    pub gbuffer: Option<PathBuf>,
+    pub gbuffer: GBufferSpec,
     pub sets: Vec<(Param, Value)>,
     pub overrides: Overrides,
     pub env_options: LoadOptions,

@@ -40,9 +40,13 @@ pub struct Inspection {
     pub x: u32,
     pub y: u32,
     pub object_id: u32,
+    /// The object's name, where the g-buffer names it.
+    pub object_name: Option<String>,
     pub coverage: f32,
     /// Every g-buffer mask's value here, by name.
     pub masks: Vec<(String, f32)>,
+    /// The full names behind masks whose channel names were made safe (material names).
+    pub mask_names: Vec<(String, String)>,
     /// Every g-buffer map channel's value here, by name (`baseColor.R`, `rough`).
     pub maps: Vec<(String, f32)>,
     /// The stack that shades the pixel, and each of its layers' weight here (`None`: hidden).
@@ -58,9 +62,16 @@ pub struct Inspection {
 impl std::fmt::Display for Inspection {
     /// One line, as a script's `pick` prints it.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "pixel {},{}: object {}, coverage {:.4}", self.x, self.y, self.object_id, self.coverage)?;
+        write!(f, "pixel {},{}: object {}", self.x, self.y, self.object_id)?;
+        if let Some(name) = &self.object_name {
+            write!(f, " '{name}'")?;
+        }
+        write!(f, ", coverage {:.4}", self.coverage)?;
         for (name, value) in &self.masks {
-            write!(f, ", mask.{name} {value:.4}")?;
+            match self.mask_names.iter().find(|(mask, _)| mask == name) {
+                Some((_, full)) => write!(f, ", mask.{name} '{full}' {value:.4}")?,
+                None => write!(f, ", mask.{name} {value:.4}")?,
+            }
         }
         for (name, value) in &self.maps {
             write!(f, ", map.{name} {value:.4}")?;
@@ -250,7 +261,8 @@ impl Session {
     /// Shows B: the look at `path`, its stacks and model under A's lighting and settings. A look
     /// that does not load or fit the g-buffer changes nothing.
     pub fn compare_look(&mut self, path: &Path) -> Result<()> {
-        let look = crate::material::Look::load(path)?;
+        let mut look = crate::material::Look::load(path)?;
+        look.resolve_object_names(&self.gbuffer.object_names, &self.gbuffer_name)?;
         let packed = PackedStacks::pack(&look, self.objects.iter().copied(), &self.gbuffer, &self.gbuffer_name)?;
         crate::material::stack::unused_stack_warnings(&look, &self.objects, &self.gbuffer_name)
             .into_iter()
@@ -499,7 +511,9 @@ impl Session {
             x,
             y,
             object_id,
+            object_name: self.gbuffer.object_names.get(&object_id).cloned(),
             coverage,
+            mask_names: self.gbuffer.mask_names.iter().map(|(m, n)| (m.clone(), n.clone())).collect(),
             masks,
             maps,
             stack,

@@ -364,20 +364,20 @@ impl State {
 
 /// Whether `object` has the stack an edit aimed at it changes, without creating one.
 fn has_stack(look: &Look, object: ObjectRef) -> bool {
-    look.objects.iter().any(|o| o.id == object.id())
+    look.objects.iter().any(|o| o.is_for(object.id()))
 }
 
 /// The stack for `object`, created first when it is missing (see [`Edit`]).
 fn stack_mut(look: &mut Look, object: ObjectRef) -> &mut ObjectStack {
     let id = object.id();
-    let index = match look.objects.iter().position(|o| o.id == id) {
+    let index = match look.objects.iter().position(|o| o.is_for(id)) {
         Some(index) => index,
         None => {
-            let layers = match look.objects.iter().find(|o| o.id.is_none()) {
+            let layers = match look.objects.iter().find(|o| o.is_default()) {
                 Some(default) => default.layers.clone(),
                 None => vec![Layer::filling(Params::default())],
             };
-            look.objects.push(ObjectStack { id, layers });
+            look.objects.push(ObjectStack::new(id, layers));
             look.objects.len() - 1
         }
     };

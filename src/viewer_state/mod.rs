@@ -116,8 +116,8 @@ impl Document {
     /// default stack (which an edit would copy). `None` when there is neither.
     pub fn stack(&self, object: ObjectRef) -> Option<&ObjectStack> {
         let objects = &self.state.look.objects;
-        let own = objects.iter().find(|o| o.id == object.id());
-        own.or_else(|| objects.iter().find(|o| o.id.is_none()))
+        let own = objects.iter().find(|o| o.id.is_some() && o.is_for(object.id()));
+        own.or_else(|| objects.iter().find(|o| o.is_default()))
     }
 
     /// Whether the content differs from what was last loaded or saved.

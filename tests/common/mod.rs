@@ -3,6 +3,7 @@
 
 pub mod albedo;
 pub mod cli;
+pub mod display;
 pub mod gltf;
 pub mod golden;
 pub mod gpu;

@@ -15,14 +15,17 @@ pub fn show(ui: &mut egui::Ui, session: &Session) {
         ui.label(format!("{}, {}", pixel.x, pixel.y));
         ui.end_row();
         ui.label("Object");
-        let name = session.gbuffer.object_names.get(&pixel.object_id).map(|n| format!(" ({n})")).unwrap_or_default();
+        let name = pixel.object_name.as_ref().map(|n| format!(" ({n})")).unwrap_or_default();
         ui.label(format!("{}{name}", pixel.object_id));
         ui.end_row();
         ui.label("Coverage");
         ui.label(format!("{:.3}", pixel.coverage));
         ui.end_row();
         for (name, value) in &pixel.masks {
-            ui.label(format!("mask.{name}"));
+            let label = ui.label(format!("mask.{name}"));
+            if let Some((_, full)) = pixel.mask_names.iter().find(|(mask, _)| mask == name) {
+                label.on_hover_text(full.as_str());
+            }
             ui.label(format!("{value:.3}"));
             ui.end_row();
         }

@@ -23,7 +23,7 @@ pub fn show(ui: &mut egui::Ui, session: &Session, actions: &mut Vec<Action>) -> 
         ui.label("This object has no stack yet.");
         return add_button(ui);
     };
-    let own = document.look().objects.iter().any(|o| o.id == object.id());
+    let own = document.look().objects.iter().any(|o| o.is_for(object.id()));
     if !own {
         ui.label(RichText::new("Shows the default stack; the first edit gives this object a copy of its own.").weak());
     }
