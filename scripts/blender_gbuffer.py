@@ -1,6 +1,6 @@
 """Writes a lookdev-ready g-buffer from a Blender scene.
 
-    blender -b shot.blend --python scripts/blender_gbuffer.py -- --out shot.exr
+    blender -b shot.blend --python-exit-code 2 --python scripts/blender_gbuffer.py -- --out shot.exr
         [--size W H] [--samples N] [--view-layer NAME] [--camera NAME]
         [--matte-material NAME]... [--matte-attribute NAME]...
 
@@ -43,6 +43,17 @@ def fail(message):
     sys.exit(2)
 
 
+def aov_output(tree, name):
+    """A shader node writing into the AOV of this name (Blender 3 names it by its name, 4 by
+    aov_name)."""
+    output = tree.nodes.new("ShaderNodeOutputAOV")
+    if hasattr(output, "aov_name"):
+        output.aov_name = name
+    else:
+        output.name = name
+    return output
+
+
 def add_matte(view_layer, name):
     aov = view_layer.aovs.get(f"mask_{name}") or view_layer.aovs.add()
     aov.name = f"mask_{name}"
@@ -52,9 +63,7 @@ def add_matte(view_layer, name):
 def matte_material(material, name):
     """Writes 1 into the AOV mask_<name> wherever this material shades."""
     material.use_nodes = True
-    nodes = material.node_tree.nodes
-    output = nodes.new("ShaderNodeOutputAOV")
-    output.name = output.aov_name = f"mask_{name}"
+    output = aov_output(material.node_tree, f"mask_{name}")
     output.inputs["Value"].default_value = 1.0
 
 
@@ -65,8 +74,7 @@ def matte_attribute(material, name):
     attribute = tree.nodes.new("ShaderNodeAttribute")
     attribute.attribute_type = "GEOMETRY"
     attribute.attribute_name = name
-    output = tree.nodes.new("ShaderNodeOutputAOV")
-    output.name = output.aov_name = f"mask_{name}"
+    output = aov_output(tree, f"mask_{name}")
     tree.links.new(attribute.outputs["Fac"], output.inputs["Value"])
 
 

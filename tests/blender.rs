@@ -63,6 +63,9 @@ def add(kind, name, location, size, mat):
 add("sphere", "Sphere", (-1.2, 0, 1), 1.0, red)
 add("sphere", "Sphere.001", (1.2, 0.5, 0.7), 0.7, gold)
 add("cube", "Cube", (0.1, -1.2, 0.45), 0.9, red)
+paint = bpy.context.object.data.attributes.new("paint", 'FLOAT', 'POINT')
+for value in paint.data:
+    value.value = 1.0
 bpy.context.view_layer.objects.active.rotation_euler = (0, 0, 0.5)
 camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
 scene.collection.objects.link(camera)
@@ -121,7 +124,8 @@ fn blender() -> Option<PathBuf> {
 }
 
 fn run_blender(blender: &Path, args: &[&str]) {
-    let output = Command::new(blender).arg("-b").args(args).output().unwrap();
+    // Without --python-exit-code, Blender exits 0 whatever the script raised.
+    let output = Command::new(blender).args(["-b", "--python-exit-code", "2"]).args(args).output().unwrap();
     let text = String::from_utf8_lossy(&output.stdout);
     assert!(
         output.status.success() && !text.contains("Error:"),
@@ -166,6 +170,10 @@ impl Renders {
                 "--",
                 "--out",
                 out.to_str().unwrap(),
+                "--matte-attribute",
+                "paint",
+                "--matte-material",
+                "Gold",
             ],
         );
         Some(Renders { dir })
@@ -303,6 +311,16 @@ fn blender_renders_relight_like_cycles_and_decode_like_the_specification() {
         worst = worst.max(glam::Vec3::from(scripted.gbuffer.view[p]).angle_between(expected).to_degrees());
     }
     assert!(worst < 0.1, "a view vector is {worst}° off the camera's ray");
+
+    // The script's custom mattes: the cube's painted attribute, and the gold material (whose
+    // mask name is taken by Cryptomatte's matte, so it is made unique).
+    let cube = &objects.iter().find(|(n, _)| n == "Cube").unwrap().1;
+    let gold = &materials.iter().find(|(n, _)| n == "Gold").unwrap().1;
+    let masks = &scripted.gbuffer.masks;
+    for p in (0..pixels).filter(|&p| objects.iter().any(|(_, c)| c[p] == 1.0)) {
+        assert_eq!(masks["paint"][p], cube[p], "mask.paint at pixel {p}");
+        assert_eq!(masks["Gold_2"][p], gold[p], "mask.Gold_2 at pixel {p}");
+    }
     assert_eq!(g.object_names.get(&2).map(String::as_str), Some("Sphere.001"));
 
     // Looks by object names and by material mattes.

@@ -630,6 +630,74 @@ emission = [1.0, 0.5, 0.0]
             write("gbuffer", &format!("shaderball-{name}.exr"), &recompress(&path, compression, false));
         }
         write("gbuffer", "shaderball-tiled.exr", &recompress(&path, exr::compression::Compression::ZIP16, true));
+        write("gbuffer", "blender-multilayer.exr", &renderer_aovs("ViewLayer.", "Normal", "Position", "CryptoObject", false));
+        write("gbuffer", "arnold-multipart.exr", &renderer_aovs("", "N", "P", "crypto_object", true));
+    }
+
+    /// A 12×10 disc as a renderer writes it: normals, positions, a Cryptomatte object layer
+    /// with its manifest, and the camera (as lookdev's Blender note, or Arnold's
+    /// worldToCamera); Blender-style (one part, a view layer's prefix) or Arnold-style (an AOV
+    /// a part).
+    fn renderer_aovs(prefix: &str, normal: &str, position: &str, crypto: &str, parts: bool) -> Vec<u8> {
+        use exr::prelude::*;
+        use lookdev::gbuffer::source::cryptomatte::{hash_to_float, murmur3_32};
+        let (w, h) = (12usize, 10usize);
+        let inside = |p: usize| {
+            let (x, y) = ((p % w) as f32 - 5.5, (p / w) as f32 - 4.5);
+            x * x + y * y < 16.0
+        };
+        // Facing the camera: Blender's at −Y (Z up), Arnold's at +Z (Y up).
+        let toward = if parts { [0.0, 0.0, 1.0] } else { [0.0, -1.0, 0.0] };
+        let n: Vec<[f32; 3]> = (0..w * h).map(|p| if inside(p) { toward } else { [0.0; 3] }).collect();
+        let points: Vec<[f32; 3]> = (0..w * h).map(|p| if inside(p) { [p as f32 * 0.01, 0.0, 1.0] } else { [0.0; 3] }).collect();
+        let id = hash_to_float(murmur3_32(b"disc"));
+        let vector = |layer: &str, v: &[[f32; 3]], names: [&str; 3]| -> Vec<AnyChannel<FlatSamples>> {
+            (0..3).map(|k| AnyChannel::new(Text::from(format!("{prefix}{layer}.{}", names[k]).as_str()), FlatSamples::F32(v.iter().map(|x| x[k]).collect()))).collect()
+        };
+        let rank: Vec<AnyChannel<FlatSamples>> = [
+            (0..w * h).map(|p| if inside(p) { id } else { 0.0 }).collect::<Vec<f32>>(),
+            (0..w * h).map(|p| if inside(p) { 1.0 } else { 0.0 }).collect(),
+            vec![0.0; w * h],
+            vec![0.0; w * h],
+        ]
+        .into_iter()
+        .zip(["r", "g", "b", "a"])
+        .map(|(values, c)| AnyChannel::new(Text::from(format!("{prefix}{crypto}00.{c}").as_str()), FlatSamples::F32(values)))
+        .collect();
+        let mut attributes = LayerAttributes::default();
+        let layer_name = format!("{prefix}{crypto}");
+        let key = &format!("{:08x}", murmur3_32(layer_name.as_bytes()))[..7];
+        for (field, value) in [
+            ("name", layer_name.clone()),
+            ("hash", "MurmurHash3_32".into()),
+            ("conversion", "uint32_to_float32".into()),
+            ("manifest", format!("{{\"disc\":\"{:08x}\"}}", murmur3_32(b"disc"))),
+        ] {
+            attributes.other.insert(Text::from(format!("cryptomatte/{key}/{field}").as_str()), AttributeValue::Text(Text::from(value.as_str())));
+        }
+        if parts {
+            attributes.world_to_camera = Some([1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., -5., 1.]);
+        } else {
+            let note = "lookdev.camera position=0,-5,0 forward=0,1,0 projection=perspective";
+            attributes.other.insert(Text::from("Note"), AttributeValue::Text(Text::from(note)));
+        }
+        let groups = vec![
+            (normal, vector(normal, &n, if parts { ["R", "G", "B"] } else { ["X", "Y", "Z"] })),
+            (position, vector(position, &points, if parts { ["R", "G", "B"] } else { ["X", "Y", "Z"] })),
+            (crypto, rank),
+        ];
+        let layer = |name: Option<&str>, channels: Vec<AnyChannel<FlatSamples>>| {
+            let attributes = LayerAttributes { layer_name: name.map(Text::from), ..attributes.clone() };
+            Layer::new((w, h), attributes, Encoding::SMALL_LOSSLESS, AnyChannels::sort(channels.into()))
+        };
+        let layers: Vec<_> = if parts {
+            groups.into_iter().map(|(name, channels)| layer(Some(name), channels)).collect()
+        } else {
+            vec![layer(None, groups.into_iter().flat_map(|(_, c)| c).collect())]
+        };
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        Image::from_layers(ImageAttributes::new(IntegerBounds::from_dimensions((w, h))), layers).write().non_parallel().to_buffered(&mut bytes).unwrap();
+        bytes.into_inner()
     }
 
     /// The file at `path` written again with another compression, or as 8×8 tiles.
