@@ -630,7 +630,11 @@ emission = [1.0, 0.5, 0.0]
             write("gbuffer", &format!("shaderball-{name}.exr"), &recompress(&path, compression, false));
         }
         write("gbuffer", "shaderball-tiled.exr", &recompress(&path, exr::compression::Compression::ZIP16, true));
-        write("gbuffer", "blender-multilayer.exr", &renderer_aovs("ViewLayer.", "Normal", "Position", "CryptoObject", false));
+        write(
+            "gbuffer",
+            "blender-multilayer.exr",
+            &renderer_aovs("ViewLayer.", "Normal", "Position", "CryptoObject", false),
+        );
         write("gbuffer", "arnold-multipart.exr", &renderer_aovs("", "N", "P", "crypto_object", true));
     }
 
@@ -649,10 +653,18 @@ emission = [1.0, 0.5, 0.0]
         // Facing the camera: Blender's at −Y (Z up), Arnold's at +Z (Y up).
         let toward = if parts { [0.0, 0.0, 1.0] } else { [0.0, -1.0, 0.0] };
         let n: Vec<[f32; 3]> = (0..w * h).map(|p| if inside(p) { toward } else { [0.0; 3] }).collect();
-        let points: Vec<[f32; 3]> = (0..w * h).map(|p| if inside(p) { [p as f32 * 0.01, 0.0, 1.0] } else { [0.0; 3] }).collect();
+        let points: Vec<[f32; 3]> =
+            (0..w * h).map(|p| if inside(p) { [p as f32 * 0.01, 0.0, 1.0] } else { [0.0; 3] }).collect();
         let id = hash_to_float(murmur3_32(b"disc"));
         let vector = |layer: &str, v: &[[f32; 3]], names: [&str; 3]| -> Vec<AnyChannel<FlatSamples>> {
-            (0..3).map(|k| AnyChannel::new(Text::from(format!("{prefix}{layer}.{}", names[k]).as_str()), FlatSamples::F32(v.iter().map(|x| x[k]).collect()))).collect()
+            (0..3)
+                .map(|k| {
+                    AnyChannel::new(
+                        Text::from(format!("{prefix}{layer}.{}", names[k]).as_str()),
+                        FlatSamples::F32(v.iter().map(|x| x[k]).collect()),
+                    )
+                })
+                .collect()
         };
         let rank: Vec<AnyChannel<FlatSamples>> = [
             (0..w * h).map(|p| if inside(p) { id } else { 0.0 }).collect::<Vec<f32>>(),
@@ -662,7 +674,9 @@ emission = [1.0, 0.5, 0.0]
         ]
         .into_iter()
         .zip(["r", "g", "b", "a"])
-        .map(|(values, c)| AnyChannel::new(Text::from(format!("{prefix}{crypto}00.{c}").as_str()), FlatSamples::F32(values)))
+        .map(|(values, c)| {
+            AnyChannel::new(Text::from(format!("{prefix}{crypto}00.{c}").as_str()), FlatSamples::F32(values))
+        })
         .collect();
         let mut attributes = LayerAttributes::default();
         let layer_name = format!("{prefix}{crypto}");
@@ -673,7 +687,10 @@ emission = [1.0, 0.5, 0.0]
             ("conversion", "uint32_to_float32".into()),
             ("manifest", format!("{{\"disc\":\"{:08x}\"}}", murmur3_32(b"disc"))),
         ] {
-            attributes.other.insert(Text::from(format!("cryptomatte/{key}/{field}").as_str()), AttributeValue::Text(Text::from(value.as_str())));
+            attributes.other.insert(
+                Text::from(format!("cryptomatte/{key}/{field}").as_str()),
+                AttributeValue::Text(Text::from(value.as_str())),
+            );
         }
         if parts {
             attributes.world_to_camera = Some([1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., -5., 1.]);
@@ -696,7 +713,11 @@ emission = [1.0, 0.5, 0.0]
             vec![layer(None, groups.into_iter().flat_map(|(_, c)| c).collect())]
         };
         let mut bytes = std::io::Cursor::new(Vec::new());
-        Image::from_layers(ImageAttributes::new(IntegerBounds::from_dimensions((w, h))), layers).write().non_parallel().to_buffered(&mut bytes).unwrap();
+        Image::from_layers(ImageAttributes::new(IntegerBounds::from_dimensions((w, h))), layers)
+            .write()
+            .non_parallel()
+            .to_buffered(&mut bytes)
+            .unwrap();
         bytes.into_inner()
     }
 
