@@ -116,16 +116,14 @@ pub fn run(args: LintArgs) -> Result<()> {
     let mut count = 0;
     let gbuffer = match spec.file.is_some() || look.gbuffer.file.is_some() {
         true => {
+            let read = crate::render::scene::read_gbuffer(&spec, &mut look, true)?;
             // Stacks that claim the same object are findings here, not warnings.
-            let file = spec.file.clone().or_else(|| look.gbuffer.file.clone()).expect("checked");
-            let read = GBuffer::read_with(&file, &spec.source.over(&look.gbuffer.source))?;
-            read.warnings.into_iter().for_each(crate::warn);
-            for claim in look.resolve_object_names(&read.gbuffer.object_names, &file)? {
+            for claim in read.claims {
                 println!("{claim}");
                 count += 1;
             }
             // The masks and maps must be there, as for a render.
-            PackedStacks::pack(&look, covered_object_ids(&read.gbuffer), &read.gbuffer, &file)?;
+            PackedStacks::pack(&look, covered_object_ids(&read.gbuffer), &read.gbuffer, &read.name)?;
             Some(read.gbuffer)
         }
         false => {

@@ -68,7 +68,8 @@ impl Scene {
             Some(path) => environment::load::load(path, env_options)?,
             None => Environment::studio(),
         };
-        let (gbuffer, gbuffer_name) = read_gbuffer(gbuffer, &mut look, quiet)?;
+        let ReadGBuffer { gbuffer, name: gbuffer_name, claims } = read_gbuffer(gbuffer, &mut look, quiet)?;
+        claims.into_iter().for_each(crate::warn);
         if implicit_default && had_stacks {
             let unstyled: Vec<String> = covered_object_ids(&gbuffer)
                 .into_iter()
@@ -117,11 +118,19 @@ pub struct GBufferSpec {
     pub source: SourceOptions,
 }
 
+/// A g-buffer as a render reads it.
+pub struct ReadGBuffer {
+    pub gbuffer: GBuffer,
+    /// Its file, or "built-in shader ball", for messages.
+    pub name: PathBuf,
+    /// One line for each stack that claims an object an earlier stack claims.
+    pub claims: Vec<String>,
+}
+
 /// Reads the g-buffer `spec` and the look's `[gbuffer]` table name (the built-in shader ball
 /// when neither names one), prints what its file was detected as (unless `quiet`) and its
-/// warnings, and gives the look's stacks that name their objects those objects' ids. Returns the
-/// g-buffer and its name for messages.
-pub fn read_gbuffer(spec: &GBufferSpec, look: &mut Look, quiet: bool) -> Result<(GBuffer, PathBuf)> {
+/// warnings, and gives the look's stacks that name their objects those objects' ids.
+pub fn read_gbuffer(spec: &GBufferSpec, look: &mut Look, quiet: bool) -> Result<ReadGBuffer> {
     let file = spec.file.clone().or_else(|| look.gbuffer.file.clone());
     let (gbuffer, name) = match file {
         Some(path) => {
@@ -134,8 +143,8 @@ pub fn read_gbuffer(spec: &GBufferSpec, look: &mut Look, quiet: bool) -> Result<
         }
         None => (GBuffer::shaderball(BUILTIN_SIZE, BUILTIN_SIZE), PathBuf::from("built-in shader ball")),
     };
-    look.resolve_object_names(&gbuffer.object_names, &name)?.into_iter().for_each(crate::warn);
-    Ok((gbuffer, name))
+    let claims = look.resolve_object_names(&gbuffer.object_names, &name)?;
+    Ok(ReadGBuffer { gbuffer, name, claims })
 }
 
 /// What makes a valid render come out black, or show only the background, each as a warning

@@ -17,7 +17,7 @@ use crate::gpu::context::{Presentation, ValidationCounter};
 use crate::gpu::{Context, ContextOptions};
 use crate::material::stack::{unused_stack_warnings, PackedStacks};
 use crate::material::Look;
-use crate::render::scene::{covered_object_ids, dark_render_warnings, read_gbuffer};
+use crate::render::scene::{covered_object_ids, dark_render_warnings, read_gbuffer, ReadGBuffer};
 use crate::render::settings::{Overrides, Settings};
 use crate::viewer_state::{Document, Edit, ObjectRef, Selection};
 use crate::{Error, Result};
@@ -70,7 +70,8 @@ impl Inputs {
             Some(path) => environment::load::load(path, &options.env_options)?,
             None => Environment::studio(),
         };
-        let (gbuffer, gbuffer_name) = read_gbuffer(&options.gbuffer, &mut look, false)?;
+        let ReadGBuffer { gbuffer, name: gbuffer_name, claims } = read_gbuffer(&options.gbuffer, &mut look, false)?;
+        claims.into_iter().for_each(crate::warn);
         let covered = covered_object_ids(&gbuffer);
         PackedStacks::pack(&look, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
         unused_stack_warnings(&look, &covered, &gbuffer_name).into_iter().for_each(crate::warn);

@@ -461,7 +461,6 @@ fn other(
     let normals = converted(&normal_names);
     let mut out: BTreeMap<String, Samples> = BTreeMap::new();
     let mut from = vec![("N".to_string(), describe_vector(&normal_layer, up))];
-    write_vector(&mut out, &NORMAL_CHANNELS.map(String::from), normals.clone());
     if let Some((layer, names)) = &tangent {
         write_vector(&mut out, &TANGENT_CHANNELS.map(String::from), converted(names));
         from.push(("T".into(), describe_vector(layer, up)));
