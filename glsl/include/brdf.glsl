@@ -464,13 +464,22 @@ float specular_shadowing(Lobes s, View view, vec3 l) {
     return smith_g(l, s.gx, s.gy) * view.g_spec;
 }
 
-// f(l, v), without the cosine. Zero unless both directions are above the surface, which also
-// avoids the reference code's 0/0 when both are at grazing.
-vec3 disney_brdf(Lobes s, View view, vec3 l, HalfVector hv) {
+// f(l, v) by lobe, each term as it enters f: diffuse (with subsurface) and sheen are still to be
+// weighted by 1 − metallic, which lobes_total applies. Zero unless both directions are above
+// the surface, which also avoids the reference code's 0/0 when both are at grazing.
+struct BrdfLobes {
+    vec3 diffuse;
+    vec3 sheen;
+    vec3 specular;
+    float clearcoat;
+};
+
+BrdfLobes disney_lobes(Lobes s, View view, vec3 l, HalfVector hv) {
+    BrdfLobes b = BrdfLobes(vec3(0.0), vec3(0.0), vec3(0.0), 0.0);
     float cl = l.z;
     float cv = view.v.z;
     if (cl <= 0.0 || cv <= 0.0) {
-        return vec3(0.0);
+        return b;
     }
     float cd = dot(l, hv.h);
     float fl = schlick_weight(cl);
@@ -480,31 +489,41 @@ vec3 disney_brdf(Lobes s, View view, vec3 l, HalfVector hv) {
     float cd2r = cd * cd * s.roughness;
     float fss = mix(1.0, cd2r, fl) * mix(1.0, cd2r, view.fv);
     float ss = 1.25 * (fss * (1.0 / (cl + cv) - 0.5) + 0.5);
-    vec3 diffuse;
     if (MODEL_DIFFUSE == DIFFUSE_BURLEY2012) {
         float fd90 = 0.5 + 2.0 * cd2r;
         float fd = mix(1.0, fd90, fl) * mix(1.0, fd90, view.fv);
-        diffuse = (INV_PI * mix(fd, ss, s.subsurface)) * s.base_color + fh * s.sheen_color;
+        b.diffuse = (INV_PI * mix(fd, ss, s.subsurface)) * s.base_color;
     } else {
         vec3 fd = diffuse_model(s, l, view.v, hv.h, cd, fl, view.fv);
-        diffuse = mix(fd, (INV_PI * ss) * s.base_color, s.subsurface) + fh * s.sheen_color;
+        b.diffuse = mix(fd, (INV_PI * ss) * s.base_color, s.subsurface);
     }
+    b.sheen = fh * s.sheen_color;
 
     // Specular: the model's D, G and F (anisotropic GGX, separable Smith, Schlick by default).
     vec3 fs = specular_fresnel(s, cd, fh);
     float gs = specular_shadowing(s, view, l);
-    vec3 specular = (gs * hv.d_spec) * fs;
+    b.specular = (gs * hv.d_spec) * fs;
 #ifdef ENERGY_TABLE_BINDING
     if (MODEL_ENERGY_COMPENSATION != 0u) {
-        specular += s.ms_scale * ((1.0 - energy_albedo(cl, s.roughness)) * view.ms_v);
+        b.specular += s.ms_scale * ((1.0 - energy_albedo(cl, s.roughness)) * view.ms_v);
     }
 #endif
 
     // Clearcoat: GTR1 with a fixed IOR 1.5.
     float fr = mix(0.04, 1.0, fh);
     float gr = smith_g_clearcoat(cl) * view.g_coat;
+    b.clearcoat = s.clearcoat * gr * fr * hv.d_coat;
+    return b;
+}
 
-    return diffuse * (1.0 - s.metallic) + specular + vec3(s.clearcoat * gr * fr * hv.d_coat);
+// f, the lobes together.
+vec3 lobes_total(Lobes s, BrdfLobes b) {
+    return (b.diffuse + b.sheen) * (1.0 - s.metallic) + b.specular + vec3(b.clearcoat);
+}
+
+// f(l, v), without the cosine.
+vec3 disney_brdf(Lobes s, View view, vec3 l, HalfVector hv) {
+    return lobes_total(s, disney_lobes(s, view, l, hv));
 }
 
 #endif

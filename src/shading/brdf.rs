@@ -532,12 +532,23 @@ pub fn specular_shadowing(s: &Lobes, view: &View, l: Vec3) -> f32 {
     smith_g(&s.model, l, s.gx, s.gy) * view.g_spec
 }
 
-/// f(l, v), without the cosine; zero unless both directions are above the surface.
-pub fn disney_brdf(s: &Lobes, view: &View, l: Vec3, hv: &HalfVector) -> Vec3 {
+/// f(l, v) by lobe, each term as it enters f: diffuse (with subsurface) and sheen are still to
+/// be weighted by 1 − metallic, which [`lobes_total`] applies. Zero unless both directions are
+/// above the surface.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BrdfLobes {
+    pub diffuse: Vec3,
+    pub sheen: Vec3,
+    pub specular: Vec3,
+    pub clearcoat: f32,
+}
+
+pub fn disney_lobes(s: &Lobes, view: &View, l: Vec3, hv: &HalfVector) -> BrdfLobes {
+    let mut b = BrdfLobes::default();
     let cl = l.z;
     let cv = view.v.z;
     if cl <= 0.0 || cv <= 0.0 {
-        return Vec3::ZERO;
+        return b;
     }
     let cd = l.dot(hv.h);
     let fl = schlick_weight(cl);
@@ -547,28 +558,39 @@ pub fn disney_brdf(s: &Lobes, view: &View, l: Vec3, hv: &HalfVector) -> Vec3 {
     let cd2r = cd * cd * s.roughness;
     let fss = mix(1.0, cd2r, fl) * mix(1.0, cd2r, view.fv);
     let ss = 1.25 * (fss * (1.0 / (cl + cv) - 0.5) + 0.5);
-    let diffuse = if s.model.diffuse == Diffuse::Burley2012 {
+    b.diffuse = if s.model.diffuse == Diffuse::Burley2012 {
         let fd90 = 0.5 + 2.0 * cd2r;
         let fd = mix(1.0, fd90, fl) * mix(1.0, fd90, view.fv);
-        (INV_PI * mix(fd, ss, s.subsurface)) * s.base_color + fh * s.sheen_color
+        (INV_PI * mix(fd, ss, s.subsurface)) * s.base_color
     } else {
         let fd = diffuse_model(s, l, view.v, hv.h, cd, fl, view.fv);
-        fd.lerp((INV_PI * ss) * s.base_color, s.subsurface) + fh * s.sheen_color
+        fd.lerp((INV_PI * ss) * s.base_color, s.subsurface)
     };
+    b.sheen = fh * s.sheen_color;
 
     // Specular: the model's D, G and F (anisotropic GGX, separable Smith, Schlick by default).
     let fs = specular_fresnel(s, cd, fh);
     let gs = specular_shadowing(s, view, l);
-    let mut specular = (gs * hv.d_spec) * fs;
+    b.specular = (gs * hv.d_spec) * fs;
     if let (Some(table), true) = (&s.energy, s.model.energy_compensation) {
-        specular += s.ms_scale * ((1.0 - energy_albedo(table, cl, s.roughness)) * view.ms_v);
+        b.specular += s.ms_scale * ((1.0 - energy_albedo(table, cl, s.roughness)) * view.ms_v);
     }
 
     // Clearcoat: GTR1 with a fixed IOR 1.5.
     let fr = mix(0.04, 1.0, fh);
     let gr = smith_g_clearcoat(cl) * view.g_coat;
+    b.clearcoat = s.clearcoat * gr * fr * hv.d_coat;
+    b
+}
 
-    diffuse * (1.0 - s.metallic) + specular + Vec3::splat(s.clearcoat * gr * fr * hv.d_coat)
+/// f, the lobes together.
+pub fn lobes_total(s: &Lobes, b: &BrdfLobes) -> Vec3 {
+    (b.diffuse + b.sheen) * (1.0 - s.metallic) + b.specular + Vec3::splat(b.clearcoat)
+}
+
+/// f(l, v), without the cosine.
+pub fn disney_brdf(s: &Lobes, view: &View, l: Vec3, hv: &HalfVector) -> Vec3 {
+    lobes_total(s, &disney_lobes(s, view, l, hv))
 }
 
 /// f(l, v) for a material, from scratch: what the per-pixel and per-pair steps compute together.
