@@ -14,6 +14,12 @@ layout(local_size_x = 16, local_size_y = 16) in;
 #define ENERGY_TABLE_SET 0
 #define ENERGY_TABLE_BINDING 4
 
+// What is accumulated beside the total, only when asked for (docs/formats.md: AOVs): each
+// lobe's share of every estimate, and the sum of each estimate's squared luminance. Off, the
+// code below is specialised away and the images bound are 1×1 placeholders.
+layout(constant_id = 6) const uint LOBE_AOVS = 0u;
+layout(constant_id = 7) const uint VARIANCE_AOV = 0u;
+
 #include "common.glsl"
 #include "material.glsl"
 #include "brdf.glsl"
@@ -30,6 +36,16 @@ layout(set = 0, binding = 1, rgba32f) uniform readonly image2DArray resolved;
 layout(set = 0, binding = 2, rgba32f) uniform image2D accumulation;
 // The environment behind each pixel (rgb), written by the first pass of an accumulation.
 layout(set = 0, binding = 3, rgba32f) uniform writeonly image2D background;
+// With LOBE_AOVS, the running sums of each lobe's share: layers diffuse (with subsurface),
+// specular, clearcoat and sheen, all weighted as they enter the total.
+layout(set = 0, binding = 5, rgba32f) uniform image2DArray lobe_sums;
+// With VARIANCE_AOV, the running sum of each estimate's squared luminance (r).
+layout(set = 0, binding = 6, rgba32f) uniform image2D moments;
+
+const int LOBE_DIFFUSE = 0;
+const int LOBE_SPECULAR = 1;
+const int LOBE_CLEARCOAT = 2;
+const int LOBE_SHEEN = 3;
 
 layout(push_constant) uniform Pass {
     uint first_sample;     // samples the band's pixels have; 0 starts a new accumulation
@@ -78,6 +94,53 @@ vec3 estimate(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, 
     return result * pass.intensity;
 }
 
+// The same estimate as `estimate`, bit for bit, with each lobe's share of it beside: the
+// lobes' sum is the total up to float rounding.
+vec3 estimate_lobes(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, vec2 u_env, vec2 u_brdf,
+                    out vec3 shares[4]) {
+    vec3 result = vec3(0.0);
+    for (int k = 0; k < 4; k++) {
+        shares[k] = vec3(0.0);
+    }
+    float diffuse_weight = 1.0 - s.metallic;
+
+    vec4 texel;
+    vec3 d = env_sample(u_env, texel);
+    vec3 l = vec3(dot(d, fx), dot(d, fy), dot(d, fn));
+    if (l.z > 0.0 && texel.a > 0.0) {
+        HalfVector hv = make_half_vector(s, l, view.v);
+        BrdfLobes b = disney_lobes(s, view, l, hv);
+        float pdf_brdf = brdf_pdf(choice, view, l, hv);
+        float w = l.z * mis_weight_over_pdf(texel.a, pdf_brdf);
+        result += lobes_total(s, b) * w * texel.rgb;
+        shares[LOBE_DIFFUSE] += b.diffuse * diffuse_weight * w * texel.rgb;
+        shares[LOBE_SPECULAR] += b.specular * w * texel.rgb;
+        shares[LOBE_CLEARCOAT] += vec3(b.clearcoat) * w * texel.rgb;
+        shares[LOBE_SHEEN] += b.sheen * diffuse_weight * w * texel.rgb;
+    }
+
+    l = sample_brdf(s, choice, view, u_brdf);
+    if (l.z > 0.0) {
+        HalfVector hv = make_half_vector(s, l, view.v);
+        float pdf_brdf = brdf_pdf(choice, view, l, hv);
+        if (pdf_brdf > 0.0) {
+            d = normalize(l.x * fx + l.y * fy + l.z * fn);
+            texel = env_texel(env_direction_to_uv(d));
+            BrdfLobes b = disney_lobes(s, view, l, hv);
+            float w = l.z * mis_weight_over_pdf(pdf_brdf, texel.a);
+            result += lobes_total(s, b) * w * texel.rgb;
+            shares[LOBE_DIFFUSE] += b.diffuse * diffuse_weight * w * texel.rgb;
+            shares[LOBE_SPECULAR] += b.specular * w * texel.rgb;
+            shares[LOBE_CLEARCOAT] += vec3(b.clearcoat) * w * texel.rgb;
+            shares[LOBE_SHEEN] += b.sheen * diffuse_weight * w * texel.rgb;
+        }
+    }
+    for (int k = 0; k < 4; k++) {
+        shares[k] *= pass.intensity;
+    }
+    return result * pass.intensity;
+}
+
 void main() {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.x, gl_GlobalInvocationID.y + pass.first_row);
     ivec2 size = imageSize(accumulation);
@@ -114,6 +177,16 @@ void main() {
         for (uint i = pass.first_sample; i < end_sample; i++) {
             sum.rgb += emission;
         }
+        if (LOBE_AOVS != 0u && pass.first_sample == 0u) {
+            for (int k = 0; k < 4; k++) {
+                imageStore(lobe_sums, ivec3(pixel, k), vec4(0.0));
+            }
+        }
+        if (VARIANCE_AOV != 0u) {
+            float y = luminance(emission);
+            float squares = pass.first_sample == 0u ? 0.0 : imageLoad(moments, pixel).r;
+            imageStore(moments, pixel, vec4(squares + float(pass.sample_count) * y * y, 0.0, 0.0, 0.0));
+        }
     } else {
         Material m = unpack_material(imageLoad(resolved, ivec3(pixel, 0)), imageLoad(resolved, ivec3(pixel, 1)),
                                      imageLoad(resolved, ivec3(pixel, 2)), imageLoad(resolved, ivec3(pixel, 3)));
@@ -126,9 +199,37 @@ void main() {
         uint pixel_seed = hash_combine(hash_u32(pass.seed), uint(pixel.y) * uint(size.x) + uint(pixel.x));
         uint env_seed = hash_combine(pixel_seed, 0x454e56u);
         uint brdf_seed = hash_combine(pixel_seed, 0x425244u);
-        for (uint i = pass.first_sample; i < end_sample; i++) {
-            sum.rgb += emission + estimate(s, choice, view_terms, fx, fy, fn, sobol_owen_2d(i, env_seed),
-                                           sobol_owen_2d(i, brdf_seed));
+        if (LOBE_AOVS == 0u && VARIANCE_AOV == 0u) {
+            for (uint i = pass.first_sample; i < end_sample; i++) {
+                sum.rgb += emission + estimate(s, choice, view_terms, fx, fy, fn, sobol_owen_2d(i, env_seed),
+                                               sobol_owen_2d(i, brdf_seed));
+            }
+        } else {
+            vec3 lobes[4];
+            for (int k = 0; k < 4; k++) {
+                lobes[k] = (LOBE_AOVS == 0u || pass.first_sample == 0u) ? vec3(0.0)
+                                                                          : imageLoad(lobe_sums, ivec3(pixel, k)).rgb;
+            }
+            float squares = (VARIANCE_AOV == 0u || pass.first_sample == 0u) ? 0.0 : imageLoad(moments, pixel).r;
+            for (uint i = pass.first_sample; i < end_sample; i++) {
+                vec3 shares[4];
+                vec3 x = emission + estimate_lobes(s, choice, view_terms, fx, fy, fn, sobol_owen_2d(i, env_seed),
+                                                   sobol_owen_2d(i, brdf_seed), shares);
+                sum.rgb += x;
+                for (int k = 0; k < 4; k++) {
+                    lobes[k] += shares[k];
+                }
+                float y = luminance(x);
+                squares += y * y;
+            }
+            if (LOBE_AOVS != 0u) {
+                for (int k = 0; k < 4; k++) {
+                    imageStore(lobe_sums, ivec3(pixel, k), vec4(lobes[k], 0.0));
+                }
+            }
+            if (VARIANCE_AOV != 0u) {
+                imageStore(moments, pixel, vec4(squares, 0.0, 0.0, 0.0));
+            }
         }
     }
     sum.a = float(end_sample);

@@ -39,7 +39,7 @@ fn glow_map() -> Environment {
             texels.push([sky + 4.0 * toward_x, sky + 2.0 * toward_x, sky * 1.6 + 0.5 * toward_x]);
         }
     }
-    Environment { width: w, height: h, texels, source: "glow".into() }
+    Environment::new(w, h, texels, "glow")
 }
 
 /// ∫ f(l, v)·cosθ·L(l) dl for a pixel, over the texels of `env`, each integrated uniformly in
@@ -139,7 +139,7 @@ fn the_map_is_oriented_and_rotated_as_specified() {
     let quadrant_colour =
         |x: u32| [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 0.0]][(x * 4 / w) as usize];
     let texels = (0..w * h).map(|i| quadrant_colour(i % w)).collect();
-    let env = Environment { width: w, height: h, texels, source: "quadrants".into() };
+    let env = Environment::new(w, h, texels, "quadrants");
     let gbuffer = orthographic_sphere(16);
     let corner = 0; // a background pixel; the orthographic camera looks down −Z
     for (rotation, expected_u) in [(0.0f64, 0.5), (90.0, 0.75), (-90.0, 0.25), (180.0, 0.0)] {
@@ -169,7 +169,7 @@ fn the_map_is_oriented_and_rotated_as_specified() {
     // A single hot texel toward +X (u = 0.75, the horizon) lights normals that face +X.
     let mut texels = vec![[0.0f32; 3]; (w * h) as usize];
     texels[((h / 2) * w + w * 3 / 4) as usize] = [1000.0; 3];
-    let env = Environment { width: w, height: h, texels, source: "hot +X".into() };
+    let env = Environment::new(w, h, texels, "hot +X");
     let look = one_material(Params { roughness: 1.0, ..Params::default() });
     let mut r = renderer(&ctx, &gbuffer, &env, &look, Lighting { background: false, ..Lighting::default() });
     r.render_samples(256).unwrap();

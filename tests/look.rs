@@ -52,7 +52,7 @@ fn toml_syntax_errors_carry_the_parsers_line() {
 fn unknown_keys_name_the_table_and_the_expected_keys() {
     assert_eq!(
         error("\n[render]\nsppp = 4\n"),
-        "looks/shot.toml:3: unknown key 'sppp' in [render] (expected spp, seed, exposure, tonemap); did you mean 'spp'?"
+        "looks/shot.toml:3: unknown key 'sppp' in [render] (expected spp, seed, exposure, tonemap, aovs); did you mean 'spp'?"
     );
     assert_eq!(
         error("[environment]\nfile = \"a.exr\"\n\nrotaton = 3\n"),
@@ -142,6 +142,13 @@ fn environment_and_render_values_are_checked() {
     assert_eq!(
         error("[render]\ntonemap = \"agz\"\n"),
         "looks/shot.toml:2: unknown tone map 'agz' (expected linear, neutral, aces, agx); did you mean 'agx'?"
+    );
+    let unknown = error("[render]\naovs = [\"N\", \"speculr\"]\n");
+    assert!(unknown.starts_with("looks/shot.toml:2: unknown AOV 'speculr'"), "{unknown}");
+    assert!(unknown.ends_with("did you mean 'specular'?"), "{unknown}");
+    assert_eq!(
+        error("[render]\naovs = \"N\"\n"),
+        "looks/shot.toml:2: aovs must be an array of strings, not the string \"N\""
     );
 }
 
@@ -371,6 +378,7 @@ background = true
 [render]
 seed = 3
 tonemap = "aces"
+aovs = ["light", "N"]
 [[object]]
 [[object.layer]]
 [object.layer.set]
@@ -400,7 +408,9 @@ emission = "glow"
     assert_eq!(gold.params.emission, [4.0, 2.0, 0.5]);
     let maps: Vec<(Param, &str)> = gold.maps.iter().map(|(p, m)| (*p, m.as_str())).collect();
     assert_eq!(maps, [(Param::BaseColor, "albedo"), (Param::Roughness, "metalRough.G"), (Param::Emission, "glow")]);
+    assert_eq!(look.render.aovs.as_deref(), Some(&["light".to_string(), "N".to_string()][..]));
     let written = look.to_toml();
+    assert!(written.contains("aovs = [\"light\", \"N\"]"), "{written}");
     assert!(written.contains("[object.layer.map]\nbase_color = \"albedo\"\nroughness = \"metalRough.G\""), "{written}");
     let again = Look::parse(&written, &path).unwrap();
     assert_eq!(again, look, "{written}");

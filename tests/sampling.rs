@@ -359,7 +359,7 @@ fn synthetic(width: u32, height: u32, sun: f32) -> Environment {
             texels.push([sky + hot + glow, sky * 1.2 + hot + glow, sky * 1.5 + hot]);
         }
     }
-    Environment { width, height, texels, source: format!("synthetic {width}x{height} sun {sun}") }
+    Environment::new(width, height, texels, format!("synthetic {width}x{height} sun {sun}"))
 }
 
 /// Environment samples binned by the distribution's own cells (exact expected counts), and by

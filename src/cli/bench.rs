@@ -24,6 +24,10 @@ pub struct BenchArgs {
     /// Single-sample passes timed for the per-pass kernel time (the median is reported).
     #[arg(long, default_value_t = 8)]
     pub passes: u32,
+    /// AOVs to accumulate beside the beauty, as `render --aov` takes them (e.g. light), to
+    /// measure what they cost.
+    #[arg(long = "aov", value_name = "NAME")]
+    pub aovs: Vec<String>,
 }
 
 const SIZES: [(u32, u32); 2] = [(512, 512), (1920, 1080)];
@@ -34,6 +38,14 @@ pub fn run(args: BenchArgs) -> Result<()> {
     let info = ctx.info().clone();
     println!("device: {} (subgroup size {})", info.name, info.subgroup_size);
     println!("scene: built-in shader ball, built-in default look, embedded studio environment");
+    let aovs =
+        crate::render::aov::Aov::parse_all(&args.aovs).map_err(|e| crate::Error::input(format!("--aov: {e}")))?;
+    let accumulate = crate::render::aov::accumulate(&aovs);
+    let beside: Vec<&str> = [(accumulate.lobes, "each lobe's share"), (accumulate.variance, "squared luminance")]
+        .into_iter()
+        .filter_map(|(on, what)| on.then_some(what))
+        .collect();
+    println!("accumulated beside the beauty: {}", if beside.is_empty() { "nothing".into() } else { beside.join(", ") });
     println!(
         "{:>10} {:>9} {:>16} {:>16} {:>14} {:>12}",
         "size", "coverage", "Msamples/s", "Msamples/s", "kernel/1spp", "wall"
@@ -60,6 +72,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         let gbuffer = &scene.gbuffer;
         let coverage = gbuffer.coverage.iter().filter(|&&a| a > 0.0).count() as f64 / gbuffer.pixel_count() as f64;
         let mut renderer = Renderer::new(&ctx, gbuffer, &scene.environment)?;
+        renderer.set_accumulate(accumulate)?;
         renderer.set_stacks(&scene.stacks)?;
         renderer.set_lighting(scene.settings.lighting);
 

@@ -127,6 +127,7 @@ pub fn overrides(lighting: &LightingArgs, sampling: &SamplingArgs, display: &Dis
         exposure: display.exposure,
         tonemap: display.tonemap,
         model: sampling.model.clone(),
+        aovs: Vec::new(),
     }
 }
 

@@ -3,8 +3,9 @@
 use super::inputs::{self, DisplayArgs, GBufferArgs, LightingArgs, SamplingArgs};
 use super::progress::Progress;
 use crate::gpu::Context;
+use crate::render::aov::{self, Aov};
 use crate::render::compare::{self, Summary};
-use crate::render::output::{self, OutputFormat};
+use crate::render::output::{self, Metadata, OutputFormat};
 use crate::render::progressive::{self, RenderStats};
 use crate::render::scene::Scene;
 use crate::render::settings::Overrides;
@@ -44,6 +45,14 @@ pub struct RenderArgs {
     /// and B side by side to --out, their ΔE*ab to <out>.diff.png, and prints the statistics.
     #[arg(long, value_name = "B.toml", num_args = 0..=1)]
     pub compare: Option<Option<PathBuf>>,
+    /// Write an AOV beside the beauty in EXR output (repeatable; instead of the look's
+    /// [render] aovs): diffuse, specular, clearcoat, sheen, emission, albedo, a parameter's name,
+    /// layers, N, V, objectId, variance, or the groups light, material, geometry, error, all.
+    #[arg(long = "aov", value_name = "NAME")]
+    pub aovs: Vec<String>,
+    /// PNG output: show this AOV instead of the beauty.
+    #[arg(long, value_name = "NAME")]
+    pub aov_display: Option<String>,
 }
 
 /// One render, read back for output.
@@ -54,25 +63,30 @@ struct Rendered {
     display: Vec<u8>,
     /// Linear radiance, for EXR output.
     radiance: Option<Vec<[f32; 4]>>,
+    /// The AOVs asked for, as EXR layers.
+    aovs: Vec<aov::Layer>,
     stats: RenderStats,
 }
 
-/// Relights `scene` on `ctx` and reads back what the output needs.
-fn render(ctx: &Context, scene: &Scene, radiance: bool, label: &str, quiet: bool) -> Result<Rendered> {
+/// Relights `scene` on `ctx` and reads back what the output needs, with the AOVs `aovs`.
+fn render(ctx: &Context, scene: &Scene, aovs: &[Aov], label: &str, quiet: bool) -> Result<Rendered> {
     scene.check_device(ctx.info())?;
     let settings = &scene.settings;
     let mut renderer = Renderer::with_model(ctx, &scene.gbuffer, &scene.environment, &settings.model)?;
+    renderer.set_accumulate(aov::accumulate(aovs))?;
     renderer.set_stacks(&scene.stacks)?;
     renderer.set_lighting(settings.lighting);
     renderer.set_seed(settings.seed);
     let mut progress = Progress::new(settings.spp as u64, label, quiet);
     let stats = progressive::accumulate(&mut renderer, settings.spp, |done| progress.update(done as u64))?;
     progress.finish();
+    let sources = aov::Sources { gbuffer: &scene.gbuffer, look: &scene.look, renderer: &renderer };
     Ok(Rendered {
         width: renderer.width,
         height: renderer.height,
         display: renderer.read_display(settings.exposure, settings.tonemap)?,
-        radiance: if radiance { Some(renderer.read_radiance()?) } else { None },
+        radiance: Some(renderer.read_radiance()?),
+        aovs: aov::layers(aovs, &sources)?,
         stats,
     })
 }
@@ -84,7 +98,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
             return Err(Error::input_file(&args.out, "the output folder does not exist"));
         }
     }
-    let overrides = inputs::overrides(&args.lighting, &args.sampling, &args.display);
+    let overrides =
+        Overrides { aovs: args.aovs.clone(), ..inputs::overrides(&args.lighting, &args.sampling, &args.display) };
     let sets = inputs::parse_sets(&args.set)?;
     let gbuffer = args.input.spec()?;
     let load = |look: Option<&Path>, overrides: &Overrides| {
@@ -94,15 +109,26 @@ pub fn run(args: RenderArgs) -> Result<()> {
         return run_compare(&args, format, second.as_deref(), &overrides, load);
     }
     let scene = load(args.look.as_deref(), &overrides)?;
+    let settings = &scene.settings;
+    // The AOVs the output writes: an EXR the ones asked for, a PNG the one it shows.
+    let display = args.aov_display.as_deref().map(|name| display_aov(name, format)).transpose()?;
+    let aovs = match (format, display) {
+        (OutputFormat::Exr, _) => settings.aovs.clone(),
+        (OutputFormat::Png, Some(aov)) => vec![aov],
+        (OutputFormat::Png, None) => Vec::new(),
+    };
 
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
     let device_name = ctx.info().name.clone();
-    let settings = &scene.settings;
-    let rendered = render(&ctx, &scene, true, "rendering", args.quiet)?;
+    let rendered = render(&ctx, &scene, &aovs, "rendering", args.quiet)?;
     drop(ctx);
     super::check_validation(&counter)?;
-    write(&args.out, format, &rendered, settings.lighting.background)?;
+    let metadata = Metadata::of_render(&scene.look, settings, &scene.environment);
+    match display {
+        Some(aov) => write_aov_png(&args.out, &rendered, aov, settings)?,
+        None => write(&args.out, format, &rendered, settings.lighting.background, &metadata)?,
+    }
     if !args.quiet {
         eprintln!(
             "lookdev: wrote {} ({}x{}, {} spp, {:.2} s on {device_name})",
@@ -116,10 +142,64 @@ pub fn run(args: RenderArgs) -> Result<()> {
     Ok(())
 }
 
-fn write(path: &Path, format: OutputFormat, rendered: &Rendered, background: bool) -> Result<()> {
+/// The one AOV `--aov-display` shows in a PNG.
+fn display_aov(name: &str, format: OutputFormat) -> Result<Aov> {
+    if format != OutputFormat::Png {
+        return Err(Error::input(format!("--aov-display {name}: only a PNG shows one AOV; an EXR takes --aov")));
+    }
+    match Aov::parse(name).map_err(|e| Error::input(format!("--aov-display: {e}")))?[..] {
+        [aov] if aov != Aov::Layers => Ok(aov),
+        _ => Err(Error::input(format!("--aov-display {name}: name one AOV, not a group"))),
+    }
+}
+
+/// A PNG of one AOV: radiance and colours through exposure and the tone map, like the beauty;
+/// other values as they are (normals and view vectors mapped from [-1, 1], ids as distinct
+/// colours, variance as its square root, the standard error).
+fn write_aov_png(
+    path: &Path,
+    rendered: &Rendered,
+    aov: Aov,
+    settings: &crate::render::settings::Settings,
+) -> Result<()> {
+    let layer = rendered.aovs.first().expect("the displayed AOV was computed");
+    let pixels = (rendered.width * rendered.height) as usize;
+    let channel = |k: usize| &layer.channels[k.min(layer.channels.len() - 1)].1;
+    let mut rgba = Vec::with_capacity(pixels * 4);
+    for p in 0..pixels {
+        let value = glam::Vec3::new(channel(0)[p], channel(1)[p], channel(2)[p]);
+        let rgb = match aov {
+            a if a.is_radiance() => crate::render::tonemap::display_pixel(value, settings.exposure, settings.tonemap),
+            Aov::Normal | Aov::View => encode(value * 0.5 + 0.5),
+            Aov::ObjectId => id_colour(value.x as u32),
+            Aov::Variance => encode(glam::Vec3::splat(value.x.sqrt())),
+            _ => encode(value),
+        };
+        rgba.extend([rgb[0], rgb[1], rgb[2], 255]);
+    }
+    output::write_png(path, rendered.width, rendered.height, &rgba, false)
+}
+
+/// A value in [0, 1] as sRGB bytes.
+fn encode(v: glam::Vec3) -> [u8; 3] {
+    v.to_array().map(|c| (crate::render::tonemap::srgb_encode(c.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8)
+}
+
+/// A distinct colour per object id (0, the background, black).
+fn id_colour(id: u32) -> [u8; 3] {
+    if id == 0 {
+        return [0; 3];
+    }
+    let h = id.wrapping_mul(0x9e37_79b9);
+    [(h >> 24) as u8 | 0x40, (h >> 16) as u8 | 0x40, (h >> 8) as u8 | 0x40]
+}
+
+fn write(path: &Path, format: OutputFormat, rendered: &Rendered, background: bool, metadata: &Metadata) -> Result<()> {
     let (width, height) = (rendered.width, rendered.height);
     match (format, &rendered.radiance) {
-        (OutputFormat::Exr, Some(radiance)) => output::write_exr(path, width, height, radiance, background),
+        (OutputFormat::Exr, Some(radiance)) => {
+            output::write_exr_with(path, width, height, radiance, background, &rendered.aovs, &metadata.entries)
+        }
         (_, radiance) => {
             // The display pixels are 8-bit; the radiance behind them shows whether any is not finite.
             radiance.as_deref().map_or(Ok(()), |radiance| output::check_finite(path, radiance))?;
@@ -176,13 +256,12 @@ fn run_compare(
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
     let device_name = ctx.info().name.clone();
-    let exr = format == OutputFormat::Exr;
-    let first = render(&ctx, &a, exr, "rendering A", args.quiet)?;
+    let first = render(&ctx, &a, &[], "rendering A", args.quiet)?;
     let second = match second_scene {
-        Second::Look(b) => render(&ctx, &b, exr, "rendering B", args.quiet)?,
+        Second::Look(b) => render(&ctx, &b, &[], "rendering B", args.quiet)?,
         Second::Model(model) => {
             a.settings.model = model;
-            render(&ctx, &a, exr, "rendering B", args.quiet)?
+            render(&ctx, &a, &[], "rendering B", args.quiet)?
         }
     };
     drop(ctx);

@@ -8,8 +8,9 @@
 use super::inputs::{self, DisplayArgs, GBufferArgs, LightingArgs, SamplingArgs};
 use super::progress::Progress;
 use crate::render::batch::Batch;
-use crate::render::output::{self, OutputFormat};
+use crate::render::output::{self, Metadata, OutputFormat};
 use crate::render::scene::Scene;
+use crate::render::settings::Overrides;
 use crate::{Error, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -32,6 +33,9 @@ pub struct TurntableArgs {
     /// Frames in the full turn.
     #[arg(long)]
     pub frames: u32,
+    /// Write an AOV beside the beauty in EXR frames (repeatable), as `render --aov` does.
+    #[arg(long = "aov", value_name = "NAME")]
+    pub aovs: Vec<String>,
     /// The frames to render, A-B inclusive, numbered from 1 (default: all).
     #[arg(long, value_name = "A-B")]
     pub range: Option<String>,
@@ -96,7 +100,8 @@ pub fn run(args: TurntableArgs) -> Result<()> {
     if let Some(dir) = pattern.path(1).parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, format!("cannot create the output folder: {e}")))?;
     }
-    let overrides = inputs::overrides(&args.lighting, &args.sampling, &args.display);
+    let overrides =
+        Overrides { aovs: args.aovs.clone(), ..inputs::overrides(&args.lighting, &args.sampling, &args.display) };
     let sets = inputs::parse_sets(&args.set)?;
     let scene = Scene::load(
         &args.input.spec()?,
@@ -122,7 +127,11 @@ pub fn run(args: TurntableArgs) -> Result<()> {
             let path = pattern.path(frame);
             match format {
                 OutputFormat::Exr => {
-                    output::write_exr(&path, width, height, &batch.radiance()?, settings.lighting.background)?
+                    let metadata = Metadata::of_render(&scene.look, &settings, &scene.environment);
+                    let aovs = batch.aovs(&scene.look, &settings)?;
+                    let radiance = batch.radiance()?;
+                    let background = settings.lighting.background;
+                    output::write_exr_with(&path, width, height, &radiance, background, &aovs, &metadata.entries)?
                 }
                 OutputFormat::Png => {
                     output::check_finite(&path, &batch.radiance()?)?;

@@ -282,7 +282,7 @@ mod tests {
         let texels = (0..w * h)
             .map(|i| if i % w > 200 && i % w < 203 && i / w == 60 { [1e6; 3] } else { [1e-4 * (i % 97) as f32; 3] })
             .collect();
-        let d = Distribution::build(&Environment { width: w, height: h, texels, source: "sun".into() });
+        let d = Distribution::build(&Environment::new(w, h, texels, "sun"));
         let mut never = 0;
         for r in 0..d.rows as usize {
             let row = d.marginal.cdf[r + 1] as f64 - d.marginal.cdf[r] as f64;
@@ -299,7 +299,7 @@ mod tests {
 
     #[test]
     fn a_small_device_limit_shrinks_the_grid_to_fit() {
-        let env = Environment { width: 64, height: 32, texels: vec![[1.0; 3]; 64 * 32], source: "x".into() };
+        let env = Environment::new(64, 32, vec![[1.0; 3]; 64 * 32], "x");
         let d = Distribution::for_device(&env, 33);
         let (width, height, _, _) = d.table_texels();
         assert!(width <= 33 && height <= 33, "{width}x{height}");
@@ -307,12 +307,7 @@ mod tests {
 
     #[test]
     fn cells_cover_the_sphere_and_probabilities_sum_to_one() {
-        let env = Environment {
-            width: 301,
-            height: 150,
-            texels: (0..301 * 150).map(|i| [(i % 17) as f32, 1.0, 0.5]).collect(),
-            source: "test".into(),
-        };
+        let env = Environment::new(301, 150, (0..301 * 150).map(|i| [(i % 17) as f32, 1.0, 0.5]).collect(), "test");
         for max_cells in [4096, 64] {
             let d = Distribution::with_max_cells(&env, max_cells);
             let mut sphere = 0.0;

@@ -37,7 +37,9 @@ const BUDGET: Budget = Budget { max_side: input::exr::MAX_SIDE, max_decoded_byte
 
 pub fn from_exr_bytes(bytes: &[u8], name: &str, options: &LoadOptions) -> Result<Environment> {
     let (width, height, texels) = read_exr_texels(bytes, name)?;
-    validate(width, height, texels, name, options)
+    let mut environment = validate(width, height, texels, name, options)?;
+    environment.content_hash = super::content_hash(bytes);
+    Ok(environment)
 }
 
 /// The RGB texels of an EXR (a Y-only file is read as grey), before any checks.
@@ -103,7 +105,9 @@ pub fn from_hdr_bytes(bytes: &[u8], name: &str, options: &LoadOptions) -> Result
     let decoded = image::DynamicImage::from_decoder(decoder).map_err(unreadable)?.into_rgb32f();
     let (width, height) = decoded.dimensions();
     let texels = decoded.pixels().map(|p| p.0).collect();
-    validate(width, height, texels, name, options)
+    let mut environment = validate(width, height, texels, name, options)?;
+    environment.content_hash = super::content_hash(bytes);
+    Ok(environment)
 }
 
 /// Refuses a Radiance header whose size the file cannot hold, before the decoder allocates it.
@@ -167,5 +171,5 @@ pub fn validate(
         }
         crate::warn(format!("{name}: clamped {summary}"));
     }
-    Ok(Environment { width, height, texels, source: name.to_string() })
+    Ok(Environment::new(width, height, texels, name))
 }

@@ -43,12 +43,26 @@ pub struct Environment {
     pub texels: Vec<[f32; 3]>,
     /// Where it came from, for messages: a path, or "built-in studio".
     pub source: String,
+    /// FNV-1a (64-bit) of the file's bytes (of its texels, for one made in memory), recorded in
+    /// renders' metadata so that a render names the exact map that lit it.
+    pub content_hash: u64,
+}
+
+/// FNV-1a, 64-bit: small, stable across versions and platforms.
+pub fn content_hash(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |hash, &b| (hash ^ b as u64).wrapping_mul(0x0100_0000_01b3))
 }
 
 /// The embedded default: studio.exr, CC0 by Greg Zaal (HDRI Haven), 1024×512, DWAB-compressed.
 const STUDIO_EXR: &[u8] = include_bytes!("studio.exr");
 
 impl Environment {
+    /// An environment of these texels (already valid), its hash from them.
+    pub fn new(width: u32, height: u32, texels: Vec<[f32; 3]>, source: impl Into<String>) -> Environment {
+        let content_hash = content_hash(bytemuck::cast_slice(&texels));
+        Environment { width, height, texels, source: source.into(), content_hash }
+    }
+
     /// The built-in studio environment.
     pub fn studio() -> Environment {
         let name = "built-in studio";
@@ -59,18 +73,15 @@ impl Environment {
         for v in texels.iter_mut().flatten() {
             *v = v.max(0.0);
         }
-        load::validate(width, height, texels, name, &LoadOptions::default())
-            .expect("the embedded studio environment is valid")
+        let mut studio = load::validate(width, height, texels, name, &LoadOptions::default())
+            .expect("the embedded studio environment is valid");
+        studio.content_hash = content_hash(STUDIO_EXR);
+        studio
     }
 
     /// A constant environment, as used by furnace tests.
     pub fn uniform(radiance: [f32; 3], width: u32, height: u32) -> Environment {
-        Environment {
-            width,
-            height,
-            texels: vec![radiance; (width * height) as usize],
-            source: format!("uniform {radiance:?}"),
-        }
+        Environment::new(width, height, vec![radiance; (width * height) as usize], format!("uniform {radiance:?}"))
     }
 
     pub fn texel(&self, x: u32, y: u32) -> [f32; 3] {

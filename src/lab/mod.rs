@@ -6,11 +6,15 @@
 //! - [`slice_directions`]: BRDF Explorer's (θh, θd, φd) parameterisation (Rusinkiewicz 1998);
 //! - [`in_plane`]: the lobe in the plane of incidence.
 
+pub mod albedo;
 pub mod furnace;
 pub mod plot;
 
 use crate::material::Params;
-use crate::shading::brdf::{disney_brdf, make_half_vector, make_lobes_with, make_view, Lobes, Shading, View};
+use crate::shading::brdf::{
+    disney_brdf, disney_lobes, lobes_total, make_half_vector, make_lobes_with, make_view, BrdfLobes, Lobes, Shading,
+    View,
+};
 use crate::shading::sampling::{
     azimuth, pdf_gtr1_reflection, pdf_specular_reflection, reflect, sample_gtr1_normal, sample_specular_normal,
 };
@@ -55,6 +59,25 @@ pub fn directional_albedo(subject: &Subject, theta_v: f32) -> Vec3 {
 }
 
 pub fn directional_albedo_with(subject: &Subject, theta_v: f32, n: usize) -> Vec3 {
+    directional_integral(subject, theta_v, n, lobes_total)
+}
+
+/// Each lobe's share of E(θv), as the lobe AOVs count them: diffuse (with subsurface) and
+/// sheen weighted by 1 − metallic, specular, clearcoat ([`crate::render::renderer::LOBES`] order:
+/// diffuse, specular, clearcoat, sheen). They sum to [`directional_albedo`].
+pub fn lobe_albedos(subject: &Subject, theta_v: f32, n: usize) -> [Vec3; 4] {
+    let weight = 1.0 - subject.params.metallic;
+    [
+        directional_integral(subject, theta_v, n, |_, b| b.diffuse * weight),
+        directional_integral(subject, theta_v, n, |_, b| b.specular),
+        directional_integral(subject, theta_v, n, |_, b| Vec3::splat(b.clearcoat)),
+        directional_integral(subject, theta_v, n, |_, b| b.sheen * weight),
+    ]
+}
+
+/// ∫ g(l)·cosθl dl over the hemisphere, g a function of the BRDF's lobes at l, with the
+/// quadrature of [`directional_albedo`].
+pub fn directional_integral(subject: &Subject, theta_v: f32, n: usize, g: impl Fn(&Lobes, &BrdfLobes) -> Vec3) -> Vec3 {
     let s = subject.lobes();
     let v = view_at(theta_v);
     let view = make_view(&s, v);
@@ -86,7 +109,7 @@ pub fn directional_albedo_with(subject: &Subject, theta_v: f32, n: usize) -> Vec
                 if p <= 0.0 {
                     continue;
                 }
-                let f = disney_brdf(&s, &view, l, &hv);
+                let f = g(&s, &disney_lobes(&s, &view, l, &hv));
                 let w = l.z as f64 / p;
                 sum[0] += f.x as f64 * w;
                 sum[1] += f.y as f64 * w;

@@ -16,6 +16,7 @@
 //! seed = 0               # any u32
 //! exposure = 0.0         # stops; within ±64
 //! tonemap = "neutral"    # linear | neutral | aces | agx
+//! aovs = ["light", "albedo"]  # AOVs written beside the beauty in EXR output
 //!
 //! [[object]]             # a layer stack; without `id` it is the default stack (at most one)
 //! id = 1
@@ -101,6 +102,8 @@ pub struct RenderSettings {
     /// Exposure in stops.
     pub exposure: Option<f32>,
     pub tonemap: Option<Tonemap>,
+    /// The AOVs renders write beside the beauty (docs/formats.md: AOVs), as written.
+    pub aovs: Option<Vec<String>>,
 }
 
 /// One `[[object]]`: the layer stack for an object id, or the default stack.
@@ -408,6 +411,10 @@ impl Look {
         if let Some(tonemap) = render.tonemap {
             body.push(format!("tonemap = {}", input::quoted(tonemap.name())));
         }
+        if let Some(aovs) = &render.aovs {
+            let names: Vec<String> = aovs.iter().map(|a| input::quoted(a)).collect();
+            body.push(format!("aovs = [{}]", names.join(", ")));
+        }
         push_section(lines, "[render]", body);
     }
 }
@@ -521,6 +528,7 @@ struct RenderFile {
     seed: Option<Field>,
     exposure: Option<Field>,
     tonemap: Option<Field>,
+    aovs: Option<Field>,
 }
 
 #[derive(Deserialize)]
@@ -623,6 +631,7 @@ fn render(src: &Source, raw: Option<RenderFile>) -> crate::Result<RenderSettings
         seed: src.read("seed", &raw.seed, |k, v| input::unsigned(k, v, 0))?,
         exposure: src.read("exposure", &raw.exposure, exposure)?,
         tonemap: src.read("tonemap", &raw.tonemap, tonemap)?,
+        aovs: src.read("aovs", &raw.aovs, aov_names)?,
     })
 }
 
@@ -741,6 +750,15 @@ fn intensity(key: &str, value: &toml::Value) -> Result<f32, String> {
     crate::environment::check_intensity(x).map(|()| x).map_err(|_| {
         format!("{key} = {} must be a number from 0 to {:e}", crate::number_text(x), crate::environment::MAX_INTENSITY)
     })
+}
+
+/// AOV names, each one lookdev writes (or a group of them).
+fn aov_names(key: &str, value: &toml::Value) -> Result<Vec<String>, String> {
+    let names = input::text_list(key, value)?;
+    for name in &names {
+        crate::render::aov::Aov::parse(name)?;
+    }
+    Ok(names)
 }
 
 fn exposure(key: &str, value: &toml::Value) -> Result<f32, String> {

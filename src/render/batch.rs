@@ -43,6 +43,7 @@ impl<'a> Batch<'a> {
     /// `settings.spp`, calling `progress(samples)` after each pass.
     pub fn render(&mut self, look: &Look, settings: &Settings, progress: impl FnMut(u32)) -> Result<()> {
         let stacks = PackedStacks::pack(look, covered_object_ids(self.gbuffer), self.gbuffer, self.gbuffer_name)?;
+        self.renderer.set_accumulate(super::aov::accumulate(&settings.aovs))?;
         self.renderer.set_stacks(&stacks)?;
         self.renderer.set_model(&settings.model)?;
         self.renderer.set_lighting(settings.lighting);
@@ -59,6 +60,12 @@ impl<'a> Batch<'a> {
     /// The last render as linear radiance.
     pub fn radiance(&self) -> Result<Vec<[f32; 4]>> {
         self.renderer.read_radiance()
+    }
+
+    /// The last render's AOVs (`settings.aovs`), of `look`.
+    pub fn aovs(&self, look: &Look, settings: &Settings) -> Result<Vec<super::aov::Layer>> {
+        let sources = super::aov::Sources { gbuffer: self.gbuffer, look, renderer: &self.renderer };
+        super::aov::layers(&settings.aovs, &sources)
     }
 }
 

@@ -1,5 +1,6 @@
 //! Rendering: parameter resolve, progressive relighting, accumulation and display transforms.
 
+pub mod aov;
 pub mod batch;
 pub mod compare;
 pub mod energy;

@@ -50,6 +50,20 @@ struct RelightPush {
     end_row: u32,
 }
 
+/// What the relight kernel accumulates beside the total, for the AOVs that need it
+/// (docs/formats.md: AOVs). What is off costs nothing: the kernel is specialised without it,
+/// and a 1×1 placeholder stands for its image.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Accumulate {
+    /// Each lobe's share of every estimate: diffuse, specular, clearcoat, sheen.
+    pub lobes: bool,
+    /// Each estimate's squared luminance, for the variance of the mean.
+    pub variance: bool,
+}
+
+/// The layers of the lobe sums, in `relight.comp`'s order.
+pub const LOBES: [&str; 4] = ["diffuse", "specular", "clearcoat", "sheen"];
+
 /// `Finalize` in finalize.comp.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -82,6 +96,10 @@ pub struct Renderer {
     shading: Shading,
     // Held so the GPU resources that descriptor sets point at stay alive.
     _energy: Buffer,
+    accumulate: Accumulate,
+    /// The lobe sums (4 layers) and the squared luminances, or 1×1 placeholders.
+    lobe_sums: Image,
+    moments: Image,
     resolved: Image,
     background: Image,
     accumulation: Image,
@@ -122,17 +140,34 @@ fn float_image(ctx: &Context, width: u32, height: u32, layers: u32, data: &[[f32
     Ok(image)
 }
 
+/// The images `accumulate` needs: the lobe sums (4 layers) and the squared luminances, each
+/// 1×1 when not asked for.
+fn accumulation_images(ctx: &Context, width: u32, height: u32, accumulate: Accumulate) -> Result<(Image, Image)> {
+    let size = |on: bool| if on { (width, height) } else { (1, 1) };
+    let (w, h) = size(accumulate.lobes);
+    let lobes = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, w, h, LOBES.len() as u32, true)?;
+    let (w, h) = size(accumulate.variance);
+    let moments = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, w, h, 1, false)?;
+    Ok((lobes, moments))
+}
+
 /// The relight pipeline for a model, and the energy table it reads (a placeholder unless the
 /// model compensates energy; the table itself is built on the GPU).
-fn relight_pipeline(ctx: &Context, model: &Model) -> Result<(ComputePipeline, Shading, Buffer)> {
+fn relight_pipeline(
+    ctx: &Context,
+    model: &Model,
+    accumulate: Accumulate,
+) -> Result<(ComputePipeline, Shading, Buffer)> {
     let image = BindingKind::StorageImage;
     let buffer = BindingKind::StorageBuffer;
+    let mut constants = model.specialization().to_vec();
+    constants.extend([accumulate.lobes as u32, accumulate.variance as u32]);
     let relight = ComputePipeline::specialized(
         ctx,
         &shaders::RELIGHT,
-        &[&[image, image, image, image, buffer], &environment::gpu::SET_LAYOUT],
+        &[&[image, image, image, image, buffer, image, image], &environment::gpu::SET_LAYOUT],
         std::mem::size_of::<RelightPush>() as u32,
-        &model.specialization(),
+        &constants,
     )?;
     let (table, energy) = if model.energy_compensation {
         let table = crate::render::energy::build(ctx, model)?;
@@ -156,7 +191,8 @@ impl Renderer {
         let image = BindingKind::StorageImage;
         let buffer = BindingKind::StorageBuffer;
         let resolve = ComputePipeline::new(ctx, &shaders::RESOLVE, &[&[image, image, buffer, buffer, image]], 0)?;
-        let (relight, shading, energy) = relight_pipeline(ctx, model)?;
+        let accumulate = Accumulate::default();
+        let (relight, shading, energy) = relight_pipeline(ctx, model, accumulate)?;
         let finalize =
             ComputePipeline::new(ctx, &shaders::FINALIZE, &[&[image; 5]], std::mem::size_of::<FinalizePush>() as u32)?;
 
@@ -176,6 +212,7 @@ impl Renderer {
         let distribution = Distribution::for_device(environment, ctx.info().max_image_dimension_2d);
         let gpu_environment = GpuEnvironment::upload(ctx, environment, &distribution)?;
         let environment_set = relight.bind(1, &gpu_environment.bindings())?;
+        let (lobe_sums, moments) = accumulation_images(ctx, width, height, accumulate)?;
         let relight_set = relight.bind(
             0,
             &[
@@ -184,6 +221,8 @@ impl Renderer {
                 Binding::Image(&accumulation),
                 Binding::Image(&background),
                 Binding::Buffer(&energy),
+                Binding::Image(&lobe_sums),
+                Binding::Image(&moments),
             ],
         )?;
         let finalize_set = finalize.bind(
@@ -205,6 +244,9 @@ impl Renderer {
             finalize,
             shading,
             _energy: energy,
+            accumulate,
+            lobe_sums,
+            moments,
             resolved,
             accumulation,
             background,
@@ -247,7 +289,24 @@ impl Renderer {
         if *model == self.shading.model {
             return Ok(());
         }
-        let (relight, shading, energy) = relight_pipeline(&self.ctx, model)?;
+        self.respecialize(*model, self.accumulate)
+    }
+
+    /// What the relight kernel accumulates beside the total (for the AOVs that need it), with
+    /// its images; accumulation restarts. Nothing happens when it is the same.
+    pub fn set_accumulate(&mut self, accumulate: Accumulate) -> Result<()> {
+        if accumulate == self.accumulate {
+            return Ok(());
+        }
+        let (lobe_sums, moments) = accumulation_images(&self.ctx, self.width, self.height, accumulate)?;
+        self.lobe_sums = lobe_sums;
+        self.moments = moments;
+        self.respecialize(self.shading.model, accumulate)
+    }
+
+    /// A new relight kernel for this model and accumulation, bound to the renderer's images.
+    fn respecialize(&mut self, model: Model, accumulate: Accumulate) -> Result<()> {
+        let (relight, shading, energy) = relight_pipeline(&self.ctx, &model, accumulate)?;
         let environment_set = relight.bind(1, &self._environment.bindings())?;
         let relight_set = relight.bind(
             0,
@@ -257,6 +316,8 @@ impl Renderer {
                 Binding::Image(&self.accumulation),
                 Binding::Image(&self.background),
                 Binding::Buffer(&energy),
+                Binding::Image(&self.lobe_sums),
+                Binding::Image(&self.moments),
             ],
         )?;
         self.relight_set = relight_set;
@@ -264,6 +325,7 @@ impl Renderer {
         self.relight = relight;
         self.shading = shading;
         self._energy = energy;
+        self.accumulate = accumulate;
         self.restart();
         Ok(())
     }
@@ -493,6 +555,58 @@ impl Renderer {
             Ok(())
         })?;
         Ok(staging.bytes()[..self.display.byte_size() as usize].to_vec())
+    }
+
+    /// The running sums (rgb) and sample counts (a) of the covered pixels; uncovered pixels hold
+    /// whatever was last written there.
+    fn read_sums(&self) -> Result<Vec<[f32; 4]>> {
+        self.check_rendered()?;
+        Ok(bytemuck::cast_slice(&self.accumulation.read(&self.ctx)?).to_vec())
+    }
+
+    /// Each lobe's mean share of the estimate per pixel ([`LOBES`] order), not yet weighted by
+    /// coverage: zero where no sample was taken. Needs [`Accumulate::lobes`].
+    pub fn read_lobes(&self, coverage: &[f32]) -> Result<Vec<Vec<[f32; 3]>>> {
+        assert!(self.accumulate.lobes, "read_lobes() needs Accumulate::lobes");
+        let sums = self.read_sums()?;
+        let layers: Vec<[f32; 4]> = bytemuck::cast_slice(&self.lobe_sums.read(&self.ctx)?).to_vec();
+        let pixels = sums.len();
+        Ok((0..LOBES.len())
+            .map(|k| {
+                (0..pixels)
+                    .map(|p| {
+                        let (sum, n) = (layers[k * pixels + p], sums[p][3]);
+                        if coverage[p] > 0.0 && n > 0.0 {
+                            [sum[0] / n, sum[1] / n, sum[2] / n]
+                        } else {
+                            [0.0; 3]
+                        }
+                    })
+                    .collect()
+            })
+            .collect())
+    }
+
+    /// The variance of each covered pixel's mean luminance, from the sum of the estimates and of
+    /// their squares: (Σx² − (Σx)²/n) / (n(n − 1)); zero with fewer than two samples. Needs
+    /// [`Accumulate::variance`].
+    pub fn read_variance(&self, coverage: &[f32]) -> Result<Vec<f32>> {
+        assert!(self.accumulate.variance, "read_variance() needs Accumulate::variance");
+        let sums = self.read_sums()?;
+        let squares: Vec<[f32; 4]> = bytemuck::cast_slice(&self.moments.read(&self.ctx)?).to_vec();
+        Ok(sums
+            .iter()
+            .zip(&squares)
+            .zip(coverage)
+            .map(|((sum, square), &a)| {
+                let n = sum[3] as f64;
+                if a <= 0.0 || n < 2.0 {
+                    return 0.0;
+                }
+                let total = crate::shading::common::luminance(glam::Vec3::new(sum[0], sum[1], sum[2])) as f64;
+                ((square[0] as f64 - total * total / n) / (n * (n - 1.0))).max(0.0) as f32
+            })
+            .collect())
     }
 
     /// The resolved material per pixel, as [`RESOLVED_LAYERS`] layers of vec4 in the layout of

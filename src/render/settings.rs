@@ -25,6 +25,8 @@ pub struct Overrides {
     pub tonemap: Option<Tonemap>,
     /// `--model KEY=VALUE`, applied in order over the look's `[model]`.
     pub model: Vec<String>,
+    /// `--aov NAME`: when given, these AOVs instead of the look's `[render] aovs`.
+    pub aovs: Vec<String>,
 }
 
 /// Everything a render needs besides the g-buffer and the stacks.
@@ -39,6 +41,8 @@ pub struct Settings {
     pub tonemap: Tonemap,
     /// The BRDF model.
     pub model: Model,
+    /// The AOVs to write beside the beauty.
+    pub aovs: Vec<crate::render::aov::Aov>,
 }
 
 impl Settings {
@@ -71,7 +75,11 @@ impl Settings {
         for text in &overrides.model {
             model.set_from_text(text).map_err(Error::input)?;
         }
+        let aov_names =
+            if overrides.aovs.is_empty() { render.aovs.clone().unwrap_or_default() } else { overrides.aovs.clone() };
+        let aovs = crate::render::aov::Aov::parse_all(&aov_names).map_err(|e| Error::input(format!("--aov: {e}")))?;
         Ok(Settings {
+            aovs,
             model,
             environment: overrides.environment.clone().or_else(|| env.file.clone()),
             lighting: Lighting {

@@ -467,7 +467,19 @@ impl Session {
                 let radiance = self.renderer.read_radiance()?;
                 // Reading radiance remade the display pixels in linear; show them as before.
                 self.renderer.finalize_rows(0, height, settings.exposure, settings.tonemap)?;
-                output::write_exr(path, width, height, &radiance, settings.lighting.background)?;
+                let environment = self.environments.iter().find(|(p, _)| *p == self.shown.environment).map(|(_, e)| e);
+                let metadata = environment
+                    .map(|e| output::Metadata::of_render(self.document.look(), &settings, e))
+                    .unwrap_or_default();
+                output::write_exr_with(
+                    path,
+                    width,
+                    height,
+                    &radiance,
+                    settings.lighting.background,
+                    &[],
+                    &metadata.entries,
+                )?;
             }
             OutputFormat::Png => {
                 output::check_finite(path, &self.renderer.read_radiance()?)?;

@@ -357,6 +357,8 @@ impl State {
             seed: keep(render.seed, s.seed, 0),
             exposure: keep(render.exposure, s.exposure, 0.0),
             tonemap: keep(render.tonemap, s.tonemap, Tonemap::default()),
+            // The viewer writes no AOVs; the look keeps its list for renders.
+            aovs: render.aovs.clone(),
         };
         self.look.model = keep(saved.model, s.model, Model::default());
     }

@@ -1,0 +1,295 @@
+//! AOVs: what a render writes beside the beauty (docs/formats.md: AOVs), each an entry of
+//! [`Aov`], computed from the renderer and the scene by [`layers`], as EXR layers named
+//! `<aov>.R .G .B` (or `.Y` for a scalar), as Nuke, Arnold and Blender name them.
+//!
+//! - Light: `diffuse` (with subsurface), `specular`, `clearcoat`, `sheen` and `emission`, each
+//!   premultiplied by coverage like the beauty: with the background off they sum to it.
+//! - Material: `albedo` and each resolved parameter, as `param_<name>` (`param_base_color`,
+//!   `param_roughness`, …; named without the prefix where no light AOV has the name).
+//! - Layers: `layers`, each layer's share of the blend, for every layer of every stack.
+//! - Geometry: `N`, `V` and `objectId`, as the g-buffer has them.
+//! - Error: `variance`, of each pixel's mean luminance.
+
+use crate::gbuffer::GBuffer;
+use crate::lab::albedo::AlbedoTables;
+use crate::material::look::{Look, ObjectStack};
+use crate::material::stack::layer_weights;
+use crate::material::{Param, Params};
+use crate::render::renderer::{Accumulate, Renderer, LOBES};
+use crate::Result;
+
+/// One AOV.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Aov {
+    /// A lobe's share of the light, in [`LOBES`] order.
+    Lobe(usize),
+    Emission,
+    Albedo,
+    Param(Param),
+    Layers,
+    Normal,
+    View,
+    ObjectId,
+    Variance,
+}
+
+/// Names that stand for several AOVs.
+const GROUPS: [(&str, &str); 5] = [
+    ("light", "diffuse, specular, clearcoat, sheen and emission"),
+    ("material", "albedo and every parameter"),
+    ("geometry", "N, V and objectId"),
+    ("error", "variance"),
+    ("all", "every AOV"),
+];
+
+impl Aov {
+    /// Every AOV, in the order they are written.
+    pub fn all() -> Vec<Aov> {
+        let mut all: Vec<Aov> = (0..LOBES.len()).map(Aov::Lobe).collect();
+        all.push(Aov::Emission);
+        all.push(Aov::Albedo);
+        all.extend(Param::ALL.into_iter().filter(|p| *p != Param::Emission).map(Aov::Param));
+        all.extend([Aov::Layers, Aov::Normal, Aov::View, Aov::ObjectId, Aov::Variance]);
+        all
+    }
+
+    /// The AOV's name, which is also its EXR layer's (for `layers`, the prefix of one per layer).
+    pub fn name(self) -> String {
+        match self {
+            Aov::Lobe(k) => LOBES[k].to_string(),
+            Aov::Emission => "emission".into(),
+            Aov::Albedo => "albedo".into(),
+            Aov::Param(p) => format!("param_{}", p.name()),
+            Aov::Layers => "layers".into(),
+            Aov::Normal => "N".into(),
+            Aov::View => "V".into(),
+            Aov::ObjectId => "objectId".into(),
+            Aov::Variance => "variance".into(),
+        }
+    }
+
+    /// The AOVs a name stands for: one, or a group. Unknown names list the names and suggest the
+    /// closest.
+    pub fn parse(name: &str) -> std::result::Result<Vec<Aov>, String> {
+        let name = name.trim();
+        let all = Aov::all();
+        let group = match name {
+            "light" => Some(all.iter().copied().filter(|a| matches!(a, Aov::Lobe(_) | Aov::Emission)).collect()),
+            "material" => Some(all.iter().copied().filter(|a| matches!(a, Aov::Albedo | Aov::Param(_))).collect()),
+            "geometry" => Some(vec![Aov::Normal, Aov::View, Aov::ObjectId]),
+            "error" => Some(vec![Aov::Variance]),
+            "all" => Some(all.clone()),
+            _ => None,
+        };
+        if let Some(group) = group {
+            return Ok(group);
+        }
+        if let Some(aov) = all.iter().find(|a| a.name() == name) {
+            return Ok(vec![*aov]);
+        }
+        // A parameter by its own name, where no light AOV has it (specular, clearcoat and sheen
+        // are the lobes; their parameters are param_specular and so on).
+        if let Some(param) = Param::from_name(name).filter(|p| *p != Param::Emission) {
+            return Ok(vec![Aov::Param(param)]);
+        }
+        let mut names: Vec<String> = all.iter().map(|a| a.name()).collect();
+        names.extend(GROUPS.iter().map(|(g, _)| g.to_string()));
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        Err(crate::material::unknown_key("AOV", name, "", &names))
+    }
+
+    /// Parses a list of names (from `--aov` or a look's `[render] aovs`), in the order of
+    /// [`Aov::all`], each once.
+    pub fn parse_all(names: &[String]) -> std::result::Result<Vec<Aov>, String> {
+        let mut aovs = Vec::new();
+        for name in names {
+            aovs.extend(Aov::parse(name)?);
+        }
+        aovs.sort();
+        aovs.dedup();
+        Ok(aovs)
+    }
+
+    /// Whether a PNG shows it through exposure and the tone map (radiance and colours), rather
+    /// than as the values themselves.
+    pub fn is_radiance(self) -> bool {
+        matches!(self, Aov::Lobe(_) | Aov::Emission | Aov::Albedo | Aov::Param(Param::BaseColor))
+    }
+}
+
+/// What the relight kernel must accumulate for these AOVs.
+pub fn accumulate(aovs: &[Aov]) -> Accumulate {
+    Accumulate { lobes: aovs.iter().any(|a| matches!(a, Aov::Lobe(_))), variance: aovs.contains(&Aov::Variance) }
+}
+
+/// One EXR layer: its name and its channels (`R`, `G`, `B`, or `Y`), per pixel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layer {
+    pub name: String,
+    pub channels: Vec<(&'static str, Vec<f32>)>,
+}
+
+impl Layer {
+    fn color(name: impl Into<String>, values: impl Iterator<Item = [f32; 3]>) -> Layer {
+        let values: Vec<[f32; 3]> = values.collect();
+        let channel = |k: usize| values.iter().map(|v| v[k]).collect();
+        Layer { name: name.into(), channels: vec![("R", channel(0)), ("G", channel(1)), ("B", channel(2))] }
+    }
+
+    fn scalar(name: impl Into<String>, values: Vec<f32>) -> Layer {
+        Layer { name: name.into(), channels: vec![("Y", values)] }
+    }
+}
+
+/// What the AOVs are computed from: the g-buffer, the look (its names resolved against the
+/// g-buffer), and the renderer after its accumulation.
+pub struct Sources<'a> {
+    pub gbuffer: &'a GBuffer,
+    pub look: &'a Look,
+    pub renderer: &'a Renderer,
+}
+
+/// The AOVs' layers, in the order of `aovs`.
+pub fn layers(aovs: &[Aov], sources: &Sources) -> Result<Vec<Layer>> {
+    let g = sources.gbuffer;
+    let coverage = &g.coverage;
+    let premultiplied = |v: [f32; 3], a: f32| v.map(|c| c * a);
+    let needs_material = aovs.iter().any(|a| matches!(a, Aov::Albedo | Aov::Param(_) | Aov::Emission));
+    let materials: Vec<Params> = if needs_material {
+        let resolved = sources.renderer.read_resolved()?;
+        let pixels = g.pixel_count();
+        (0..pixels)
+            .map(|p| {
+                let v: [f32; crate::material::params::GPU_FLOATS] =
+                    std::array::from_fn(|k| resolved[(k / 4) * pixels + p][k % 4]);
+                Params::from_gpu(&v)
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let lobes = if aovs.iter().any(|a| matches!(a, Aov::Lobe(_))) {
+        sources.renderer.read_lobes(coverage)?
+    } else {
+        Vec::new()
+    };
+    let mut out = Vec::new();
+    for &aov in aovs {
+        match aov {
+            Aov::Lobe(k) => {
+                let values = lobes[k].iter().zip(coverage).map(|(&v, &a)| premultiplied(v, a));
+                out.push(Layer::color(aov.name(), values));
+            }
+            Aov::Emission => {
+                let values = materials.iter().zip(coverage).map(|(m, &a)| premultiplied(m.emission, a));
+                out.push(Layer::color(aov.name(), values));
+            }
+            Aov::Albedo => {
+                let tables = AlbedoTables::build(sources.renderer.shading());
+                let values = materials.iter().enumerate().map(|(p, m)| {
+                    let mu = glam::Vec3::from(g.normal[p]).dot(glam::Vec3::from(g.view[p])).clamp(0.0, 1.0);
+                    if coverage[p] > 0.0 {
+                        tables.albedo(m, mu).to_array()
+                    } else {
+                        [0.0; 3]
+                    }
+                });
+                out.push(Layer::color(aov.name(), values));
+            }
+            Aov::Param(param) => {
+                let shaded = |p: usize| coverage[p] > 0.0;
+                match param.is_color() {
+                    true => out.push(Layer::color(
+                        aov.name(),
+                        (0..materials.len()).map(|p| if shaded(p) { color_of(&materials[p], param) } else { [0.0; 3] }),
+                    )),
+                    false => out.push(Layer::scalar(
+                        aov.name(),
+                        (0..materials.len())
+                            .map(|p| if shaded(p) { scalar_of(&materials[p], param) } else { 0.0 })
+                            .collect(),
+                    )),
+                }
+            }
+            Aov::Layers => out.extend(layer_weight_layers(sources)),
+            Aov::Normal => out.push(Layer::color(aov.name(), g.normal.iter().copied())),
+            Aov::View => out.push(Layer::color(aov.name(), g.view.iter().copied())),
+            Aov::ObjectId => out.push(Layer::scalar(aov.name(), g.object_id.iter().map(|&id| id as f32).collect())),
+            Aov::Variance => out.push(Layer::scalar(aov.name(), sources.renderer.read_variance(coverage)?)),
+        }
+    }
+    Ok(out)
+}
+
+fn color_of(m: &Params, param: Param) -> [f32; 3] {
+    match m.get(param) {
+        crate::material::Value::Color(c) => c,
+        crate::material::Value::Scalar(x) => [x; 3],
+    }
+}
+
+fn scalar_of(m: &Params, param: Param) -> f32 {
+    match m.get(param) {
+        crate::material::Value::Scalar(x) => x,
+        crate::material::Value::Color(c) => c[0],
+    }
+}
+
+/// The name a stack's layers are written under: `default`, the object's name, or `object<id>`.
+fn stack_label(stack: &ObjectStack, gbuffer: &GBuffer) -> String {
+    let name = match (&stack.name, stack.id) {
+        (Some(name), _) => name.clone(),
+        (None, Some(id)) => gbuffer.object_names.get(&id).cloned().unwrap_or_else(|| format!("object{id}")),
+        (None, None) => "default".into(),
+    };
+    crate::asset::channel_name(&name)
+}
+
+/// One layer per layer of every stack: `layers_<stack>_<index>_<preset>.Y`, the layer's weight
+/// in the blend where that stack shades: its share of the resolved material (the matte of where
+/// it shows), so a stack's layers sum to 1 there; 0 elsewhere.
+fn layer_weight_layers(sources: &Sources) -> Vec<Layer> {
+    let g = sources.gbuffer;
+    let look = sources.look;
+    let mut out = Vec::new();
+    for stack in &look.objects {
+        let label = stack_label(stack, g);
+        let mut values = vec![vec![0.0f32; g.pixel_count()]; stack.layers.len()];
+        for p in 0..g.pixel_count() {
+            if g.coverage[p] <= 0.0 || !std::ptr::eq(look.stack_for(g.object_id[p]).unwrap_or(stack), stack) {
+                continue;
+            }
+            let mask = |name: &str| g.masks.get(name).map_or(0.0, |m| m[p]);
+            for (i, weight) in layer_weights(stack, mask).into_iter().enumerate() {
+                values[i][p] = weight.map_or(0.0, |w| w.contribution);
+            }
+        }
+        for (i, (layer, values)) in stack.layers.iter().zip(values).enumerate() {
+            let preset = crate::asset::channel_name(layer.preset.as_deref().unwrap_or("layer"));
+            out.push(Layer::scalar(format!("layers_{label}_{i}_{preset}"), values));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_and_groups_parse() {
+        assert_eq!(Aov::parse("specular").unwrap(), vec![Aov::Lobe(1)]);
+        assert_eq!(Aov::parse("light").unwrap().len(), 5);
+        assert_eq!(Aov::parse("roughness").unwrap(), vec![Aov::Param(Param::Roughness)]);
+        assert_eq!(Aov::parse("param_specular").unwrap(), vec![Aov::Param(Param::Specular)]);
+        assert_eq!(Aov::parse("specular").unwrap(), vec![Aov::Lobe(1)], "the lobe, not the parameter");
+        let all = Aov::parse_all(&["N".into(), "light".into(), "diffuse".into()]).unwrap();
+        assert_eq!(all.first(), Some(&Aov::Lobe(0)), "in the order written, each once");
+        assert_eq!(all.iter().filter(|a| **a == Aov::Lobe(0)).count(), 1);
+        let message = Aov::parse("specullar").unwrap_err();
+        assert!(
+            message.contains("unknown AOV 'specullar'") && message.contains("did you mean 'specular'?"),
+            "{message}"
+        );
+    }
+}
