@@ -5,19 +5,18 @@ mod common;
 
 use common::golden::golden;
 
-use lookdev::environment::Environment;
-use lookdev::gbuffer::GBuffer;
 use lookdev::material::Look;
-use lookdev::render::scene::Scene;
-use lookdev::render::settings::{Overrides, Settings};
+use lookdev::render::scene::{GBufferSpec, LookSource, Scene, SceneSpec};
 use lookdev::render::{progressive, Renderer};
 
 fn render(look: Look, size: u32, spp: u32) -> Vec<u8> {
     let ctx = common::gpu::context();
-    let settings = Settings::resolve(&look, &Overrides::default()).unwrap();
-    let scene =
-        Scene::new(GBuffer::shaderball(size, size), "shader ball".into(), look, Environment::studio(), settings)
-            .unwrap();
+    let scene = Scene::load(&SceneSpec {
+        look: LookSource::Given(Box::new(look)),
+        gbuffer: GBufferSpec { builtin_size: Some((size, size)), ..GBufferSpec::default() },
+        ..SceneSpec::default()
+    })
+    .unwrap();
     let rgba = {
         let mut renderer = Renderer::new(&ctx, &scene.gbuffer, &scene.environment).unwrap();
         renderer.set_stacks(&scene.stacks).unwrap();

@@ -184,6 +184,32 @@ fn the_viewer_opens_renders_and_its_screenshot_matches_lookdev_render() {
     assert!(mean_level > 20.0, "the image is nearly black: {mean_level}");
 }
 
+/// `view --set` reaches every object, as `render --set` does, also on a look with no default
+/// stack: the pedestal (object 2), which has no stack of its own, takes the red too.
+#[test]
+fn view_set_reaches_the_objects_render_set_reaches() {
+    let Some(case) = Case::new() else { return };
+    case.write("ball-only.toml", "[[object]]\nid = 1\n[[object.layer]]\npreset = \"gold\"\n");
+    let set = ["--set", "base_color=0.9,0.1,0.1", "--seed", "3"];
+    let output =
+        case.view(&[&["ball-only.toml"][..], &set, &["--exit-after-spp", "4", "--screenshot", "shot.png"]].concat());
+    assert_success(&output);
+    let shot = case.screenshot_image(&output, "shot.png");
+    let render = |out: &str, set: &[&str]| {
+        let args = [
+            &["render", "--gbuffer", "g.exr", "--look", "ball-only.toml", "--spp", "4", "--quiet"][..],
+            set,
+            &["--seed", "3", "--out", out],
+        ]
+        .concat();
+        assert_success(&case.command(&args).output().unwrap());
+        image::open(case.path(out)).unwrap().into_rgb8()
+    };
+    let with_set = render("set.png", &set[..2]);
+    assert_matches_render(&shot, &with_set);
+    assert_differs(&with_set, &render("plain.png", &[]), "--set on the stackless pedestal");
+}
+
 #[test]
 fn a_scripted_edit_changes_the_image_and_is_saved_to_the_look() {
     let Some(case) = Case::new() else { return };

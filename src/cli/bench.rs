@@ -4,11 +4,7 @@
 //! Throughput is reported over all pixels (as image renderers count) and over covered pixels
 //! only (the pixels that actually shade; the background costs one lookup per pixel and pass).
 
-use crate::environment::Environment;
-use crate::gbuffer::GBuffer;
-use crate::material::Look;
-use crate::render::scene::Scene;
-use crate::render::settings::{Overrides, Settings};
+use crate::render::scene::{GBufferSpec, Scene, SceneSpec};
 use crate::render::{progressive, Renderer};
 use crate::Result;
 use clap::Args;
@@ -60,15 +56,11 @@ pub fn run(args: BenchArgs) -> Result<()> {
         format!("({} spp)", args.spp)
     );
     for (width, height) in SIZES {
-        let look = Look::builtin_default();
-        let settings = Settings::resolve(&look, &Overrides::default())?;
-        let scene = Scene::new(
-            GBuffer::shaderball(width, height),
-            "built-in shader ball".into(),
-            look,
-            Environment::studio(),
-            settings,
-        )?;
+        let scene = Scene::load(&SceneSpec {
+            gbuffer: GBufferSpec { builtin_size: Some((width, height)), ..GBufferSpec::default() },
+            quiet: true,
+            ..SceneSpec::default()
+        })?;
         let gbuffer = &scene.gbuffer;
         let coverage = gbuffer.coverage.iter().filter(|&&a| a > 0.0).count() as f64 / gbuffer.pixel_count() as f64;
         let mut renderer = Renderer::new(&ctx, gbuffer, &scene.environment)?;

@@ -1,16 +1,54 @@
 //! The flags every rendering command shares: the g-buffer, lighting, sampling, display, and
-//! `--set`.
+//! `--set`, gathered in [`SceneArgs`] for `render`, `turntable` and `view`, and turned into
+//! the [`SceneSpec`] that [`crate::render::scene::Scene::load`] reads.
 
-use crate::environment::{self, Environment, LoadOptions};
+use crate::environment::LoadOptions;
 use crate::gbuffer::source::{Channels, SourceOptions, Up};
-use crate::gbuffer::GBuffer;
 use crate::material::{Look, Param, Value};
-use crate::render::scene::GBufferSpec;
-use crate::render::settings::{Overrides, Settings};
+use crate::render::scene::{GBufferSpec, LookSource, SceneSpec};
+use crate::render::settings::Overrides;
 use crate::render::tonemap::Tonemap;
 use crate::{Error, Result};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+/// The flags `render`, `turntable` and `view` share, flattened into each.
+#[derive(Args, Debug, Default)]
+pub struct SceneArgs {
+    #[command(flatten)]
+    pub gbuffer: GBufferArgs,
+    /// Override a parameter on every layer of every object, e.g. --set metallic=1.
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+    #[command(flatten)]
+    pub lighting: LightingArgs,
+    #[command(flatten)]
+    pub sampling: SamplingArgs,
+    #[command(flatten)]
+    pub display: DisplayArgs,
+}
+
+impl SceneArgs {
+    /// The scene these flags describe with the look `look` (the default one if `None`) and
+    /// the AOVs `aovs`.
+    pub fn spec(&self, look: Option<&Path>, aovs: &[String], quiet: bool) -> Result<SceneSpec> {
+        Ok(SceneSpec {
+            look: look.map_or(LookSource::Default, |path| LookSource::File(path.to_path_buf())),
+            gbuffer: self.gbuffer.spec()?,
+            sets: parse_sets(&self.set)?,
+            overrides: Overrides { aovs: aovs.to_vec(), ..overrides(&self.lighting, &self.sampling, &self.display) },
+            env_options: self.lighting.load_options(),
+            quiet,
+        })
+    }
+
+    /// Refuses bad flags before anything is read: `--set`, the g-buffer's channel flags, and
+    /// the look's settings as the flags (and `aovs`) override them.
+    pub fn check(&self, aovs: &[String]) -> Result<()> {
+        let spec = self.spec(None, aovs, true)?;
+        crate::render::settings::Settings::resolve(&Look::default_material(), &spec.overrides).map(|_| ())
+    }
+}
 
 /// The g-buffer and how to read it (docs/formats.md: Production renders).
 #[derive(Args, Debug, Default, Clone)]
@@ -57,7 +95,7 @@ impl GBufferArgs {
             camera_position: self.camera_position,
             channels,
         };
-        Ok(GBufferSpec { file: self.gbuffer.clone(), source })
+        Ok(GBufferSpec { file: self.gbuffer.clone(), source, builtin_size: None })
     }
 }
 
@@ -116,7 +154,7 @@ pub struct DisplayArgs {
 }
 
 /// The command-line overrides of a look's settings.
-pub fn overrides(lighting: &LightingArgs, sampling: &SamplingArgs, display: &DisplayArgs) -> Overrides {
+fn overrides(lighting: &LightingArgs, sampling: &SamplingArgs, display: &DisplayArgs) -> Overrides {
     Overrides {
         environment: lighting.env.clone(),
         rotation: lighting.rotation,
@@ -132,30 +170,26 @@ pub fn overrides(lighting: &LightingArgs, sampling: &SamplingArgs, display: &Dis
 }
 
 /// Parses every `--set NAME=VALUE`.
-pub fn parse_sets(texts: &[String]) -> Result<Vec<(Param, Value)>> {
+fn parse_sets(texts: &[String]) -> Result<Vec<(Param, Value)>> {
     texts.iter().map(|t| super::parse_set(t)).collect()
 }
 
-/// What `presets sheet` and `wedge` render with: the settings of `look` under the flags, `spp`
-/// and `model`, its environment, and the built-in shader ball `size` pixels square.
-pub fn ball_inputs(
-    look: &Look,
+/// What `presets sheet` and `wedge` render: `look` under the flags, `spp` and `model`, on the
+/// built-in shader ball `size` pixels square.
+pub fn ball_spec(
+    look: Look,
     lighting: &LightingArgs,
     display: &DisplayArgs,
     spp: u32,
     model: &[String],
     size: u32,
-) -> Result<(Settings, Environment, GBuffer)> {
+) -> SceneSpec {
     let sampling = SamplingArgs { spp: Some(spp), model: model.to_vec(), ..SamplingArgs::default() };
-    let settings = Settings::resolve(look, &overrides(lighting, &sampling, display))?;
-    let environment = match &settings.environment {
-        Some(path) => environment::load::load(path, &lighting.load_options())?,
-        None => Environment::studio(),
-    };
-    let gbuffer = GBuffer::shaderball(size, size);
-    let name = std::path::Path::new("built-in shader ball");
-    crate::render::scene::dark_render_warnings(&gbuffer, name, &environment, settings.lighting.intensity)
-        .into_iter()
-        .for_each(crate::warn);
-    Ok((settings, environment, gbuffer))
+    SceneSpec {
+        look: LookSource::Given(Box::new(look)),
+        gbuffer: GBufferSpec { builtin_size: Some((size, size)), ..GBufferSpec::default() },
+        overrides: overrides(lighting, &sampling, display),
+        env_options: lighting.load_options(),
+        ..SceneSpec::default()
+    }
 }

@@ -95,25 +95,13 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
 /// refused before anything is read or started.
 pub fn check(command: &Command) -> Result<()> {
     match command {
-        Command::Render(a) => check_look_flags(&a.set, &a.lighting, &a.sampling, &a.display),
-        Command::Turntable(a) => check_look_flags(&a.set, &a.lighting, &a.sampling, &a.display),
-        Command::View(a) => check_look_flags(&a.set, &a.lighting, &a.sampling, &a.display),
+        Command::Render(a) => a.scene.check(&a.aovs),
+        Command::Turntable(a) => a.scene.check(&a.aovs),
+        Command::View(a) => a.scene.check(&[]),
         Command::Bake(a) => bake::check(a),
         Command::Presets(a) => presets::check(a),
         _ => Ok(()),
     }
-}
-
-/// `--set`, and the look's settings as the lighting, sampling and display flags override them.
-fn check_look_flags(
-    sets: &[String],
-    lighting: &inputs::LightingArgs,
-    sampling: &inputs::SamplingArgs,
-    display: &inputs::DisplayArgs,
-) -> Result<()> {
-    inputs::parse_sets(sets)?;
-    let overrides = inputs::overrides(lighting, sampling, display);
-    crate::render::settings::Settings::resolve(&crate::material::Look::default_material(), &overrides).map(|_| ())
 }
 
 /// Runs `run`, turning a panic into an [`ErrorKind::Internal`](crate::ErrorKind) error: every

@@ -7,6 +7,7 @@ use crate::material::look::{Layer, Look};
 use crate::material::params::{Param, Params};
 use crate::material::Preset;
 use crate::render::batch::{preset_on_ball, Batch};
+use crate::render::scene::Scene;
 use crate::render::sheet::{self, Cell};
 use crate::{Error, Result};
 use clap::{Args, Subcommand};
@@ -261,12 +262,12 @@ fn sheet(args: SheetArgs) -> Result<()> {
     if args.lighting.env.is_some() {
         base.environment = Default::default();
     }
-    let (settings, environment, gbuffer) =
-        inputs::ball_inputs(&base, &args.lighting, &args.display, args.spp, &args.model, args.size)?;
+    let Scene { gbuffer, gbuffer_name, environment, settings, .. } =
+        Scene::load(&inputs::ball_spec(base, &args.lighting, &args.display, args.spp, &args.model, args.size))?;
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
     let cells = {
-        let mut batch = Batch::new(&ctx, &gbuffer, Path::new("built-in shader ball"), &environment)?;
+        let mut batch = Batch::new(&ctx, &gbuffer, &gbuffer_name, &environment)?;
         let mut progress = Progress::new(presets.len() as u64, "presets", args.quiet);
         let mut cells = Vec::new();
         for (i, (preset, origin)) in presets.iter().enumerate() {

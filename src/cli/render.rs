@@ -1,13 +1,13 @@
 //! `lookdev render`.
 
-use super::inputs::{self, DisplayArgs, GBufferArgs, LightingArgs, SamplingArgs};
+use super::inputs::SceneArgs;
 use super::progress::Progress;
 use crate::gpu::Context;
 use crate::render::aov::{self, Aov};
 use crate::render::compare::{self, Summary};
 use crate::render::output::{self, Metadata, OutputFormat};
 use crate::render::progressive::{self, RenderStats};
-use crate::render::scene::Scene;
+use crate::render::scene::{LookSource, Scene, SceneSpec};
 use crate::render::settings::Overrides;
 use crate::render::Renderer;
 use crate::shading::model::Model;
@@ -17,20 +17,11 @@ use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    #[command(flatten)]
-    pub input: GBufferArgs,
     /// The look: layer stacks, environment and render settings.
     #[arg(long, value_name = "FILE.toml")]
     pub look: Option<PathBuf>,
-    /// Override a parameter on every layer of every object, e.g. --set metallic=1.
-    #[arg(long = "set", value_name = "NAME=VALUE")]
-    pub set: Vec<String>,
     #[command(flatten)]
-    pub lighting: LightingArgs,
-    #[command(flatten)]
-    pub sampling: SamplingArgs,
-    #[command(flatten)]
-    pub display: DisplayArgs,
+    pub scene: SceneArgs,
     /// Vulkan device to use: part of its name (lavapipe is "llvmpipe").
     #[arg(long, value_name = "NAME")]
     pub device: Option<String>,
@@ -98,17 +89,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
             return Err(Error::input_file(&args.out, "the output folder does not exist"));
         }
     }
-    let overrides =
-        Overrides { aovs: args.aovs.clone(), ..inputs::overrides(&args.lighting, &args.sampling, &args.display) };
-    let sets = inputs::parse_sets(&args.set)?;
-    let gbuffer = args.input.spec()?;
-    let load = |look: Option<&Path>, overrides: &Overrides| {
-        Scene::load(&gbuffer, look, &sets, overrides, &args.lighting.load_options(), args.quiet)
-    };
+    let spec = args.scene.spec(args.look.as_deref(), &args.aovs, args.quiet)?;
     if let Some(second) = &args.compare {
-        return run_compare(&args, format, second.as_deref(), &overrides, load);
+        return run_compare(&args, format, second.as_deref(), &spec);
     }
-    let scene = load(args.look.as_deref(), &overrides)?;
+    let scene = Scene::load(&spec)?;
     let settings = &scene.settings;
     // The AOVs the output writes: an EXR the ones asked for, a PNG the one it shows.
     let display = args.aov_display.as_deref().map(|name| display_aov(name, format)).transpose()?;
@@ -210,16 +195,12 @@ fn write(path: &Path, format: OutputFormat, rendered: &Rendered, background: boo
 
 /// `--compare`: renders A and B, writes them side by side and their difference, and prints the
 /// difference's statistics.
-fn run_compare(
-    args: &RenderArgs,
-    format: OutputFormat,
-    second_look: Option<&Path>,
-    overrides: &Overrides,
-    load: impl Fn(Option<&Path>, &Overrides) -> Result<Scene>,
-) -> Result<()> {
+fn run_compare(args: &RenderArgs, format: OutputFormat, second_look: Option<&Path>, spec: &SceneSpec) -> Result<()> {
+    let overrides = &spec.overrides;
+    let with_look = |look: &Path| SceneSpec { look: LookSource::File(look.to_path_buf()), ..spec.clone() };
     let look_name = |look: Option<&Path>| match look.and_then(Path::file_name) {
         Some(name) => name.to_string_lossy().into_owned(),
-        None if args.input.gbuffer.is_none() => "built-in look".to_string(),
+        None if spec.gbuffer.file.is_none() => "built-in look".to_string(),
         None => "default material".to_string(),
     };
     // B is either a second look, read on its own, or A's scene with another model: then the
@@ -229,11 +210,12 @@ fn run_compare(
         Model(Model),
     }
     let (mut a, second_scene) = match second_look {
-        Some(b_look) => {
-            (load(args.look.as_deref(), overrides)?, Second::Look(Box::new(load(Some(b_look), overrides)?)))
-        }
+        Some(b_look) => (Scene::load(spec)?, Second::Look(Box::new(Scene::load(&with_look(b_look))?))),
         None if !overrides.model.is_empty() => {
-            let a = load(args.look.as_deref(), &Overrides { model: Vec::new(), ..overrides.clone() })?;
+            let a = Scene::load(&SceneSpec {
+                overrides: Overrides { model: Vec::new(), ..overrides.clone() },
+                ..spec.clone()
+            })?;
             let mut model = a.settings.model;
             for text in &overrides.model {
                 model.set_from_text(text).map_err(Error::input)?;

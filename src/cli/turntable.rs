@@ -5,12 +5,11 @@
 //! different machines with the same device and driver (and any `--range` split) match a single
 //! run bit for bit.
 
-use super::inputs::{self, DisplayArgs, GBufferArgs, LightingArgs, SamplingArgs};
+use super::inputs::SceneArgs;
 use super::progress::Progress;
 use crate::render::batch::Batch;
 use crate::render::output::{self, Metadata, OutputFormat};
 use crate::render::scene::Scene;
-use crate::render::settings::Overrides;
 use crate::{Error, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -20,16 +19,7 @@ pub struct TurntableArgs {
     #[arg(long, value_name = "FILE.toml")]
     pub look: Option<PathBuf>,
     #[command(flatten)]
-    pub input: GBufferArgs,
-    /// Override a parameter on every layer of every object, e.g. --set metallic=1.
-    #[arg(long = "set", value_name = "NAME=VALUE")]
-    pub set: Vec<String>,
-    #[command(flatten)]
-    pub lighting: LightingArgs,
-    #[command(flatten)]
-    pub sampling: SamplingArgs,
-    #[command(flatten)]
-    pub display: DisplayArgs,
+    pub scene: SceneArgs,
     /// Frames in the full turn.
     #[arg(long)]
     pub frames: u32,
@@ -100,17 +90,7 @@ pub fn run(args: TurntableArgs) -> Result<()> {
     if let Some(dir) = pattern.path(1).parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, format!("cannot create the output folder: {e}")))?;
     }
-    let overrides =
-        Overrides { aovs: args.aovs.clone(), ..inputs::overrides(&args.lighting, &args.sampling, &args.display) };
-    let sets = inputs::parse_sets(&args.set)?;
-    let scene = Scene::load(
-        &args.input.spec()?,
-        args.look.as_deref(),
-        &sets,
-        &overrides,
-        &args.lighting.load_options(),
-        args.quiet,
-    )?;
+    let scene = Scene::load(&args.scene.spec(args.look.as_deref(), &args.aovs, args.quiet)?)?;
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
     scene.check_device(ctx.info())?;

@@ -1,6 +1,6 @@
 //! `lookdev view`: the interactive viewer.
 
-use super::inputs::{self, DisplayArgs, GBufferArgs, LightingArgs, SamplingArgs};
+use super::inputs::SceneArgs;
 use crate::{Error, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -12,16 +12,7 @@ pub struct ViewArgs {
     #[arg(value_name = "LOOK.toml")]
     pub look: Option<PathBuf>,
     #[command(flatten)]
-    pub input: GBufferArgs,
-    /// Override a parameter on every layer of every object when the look opens.
-    #[arg(long = "set", value_name = "NAME=VALUE")]
-    pub set: Vec<String>,
-    #[command(flatten)]
-    pub lighting: LightingArgs,
-    #[command(flatten)]
-    pub sampling: SamplingArgs,
-    #[command(flatten)]
-    pub display: DisplayArgs,
+    pub scene: SceneArgs,
     /// Vulkan device to use: part of its name (lavapipe is "llvmpipe").
     #[arg(long, value_name = "NAME")]
     pub device: Option<String>,
@@ -68,9 +59,8 @@ pub fn run(args: ViewArgs) -> Result<()> {
     for key in &args.compare_model {
         model.set_from_flag("--compare-model", key).map_err(Error::input)?;
     }
-    let sets = inputs::parse_sets(&args.set)?;
-    let overrides = inputs::overrides(&args.lighting, &args.sampling, &args.display);
-    open(args, sets, overrides, window_size)
+    let scene = args.scene.spec(args.look.as_deref(), &[], false)?;
+    open(args, scene, window_size)
 }
 
 #[cfg(feature = "viewer")]
@@ -79,19 +69,10 @@ const DEFAULT_WINDOW_SIZE: (u32, u32) = crate::viewer::DEFAULT_WINDOW_SIZE;
 const DEFAULT_WINDOW_SIZE: (u32, u32) = (1600, 960);
 
 #[cfg(feature = "viewer")]
-fn open(
-    args: ViewArgs,
-    sets: Vec<(crate::material::Param, crate::material::Value)>,
-    overrides: crate::render::settings::Overrides,
-    window_size: (u32, u32),
-) -> Result<()> {
+fn open(args: ViewArgs, scene: crate::render::scene::SceneSpec, window_size: (u32, u32)) -> Result<()> {
     let script = args.script.as_deref().map(crate::viewer::Script::load).transpose()?;
     crate::viewer::run(crate::viewer::ViewOptions {
-        env_options: args.lighting.load_options(),
-        look: args.look,
-        gbuffer: args.input.spec()?,
-        sets,
-        overrides,
+        scene,
         device: args.device,
         window_size,
         screenshot: args.screenshot,
@@ -103,11 +84,6 @@ fn open(
 }
 
 #[cfg(not(feature = "viewer"))]
-fn open(
-    _args: ViewArgs,
-    _sets: Vec<(crate::material::Param, crate::material::Value)>,
-    _overrides: crate::render::settings::Overrides,
-    _window_size: (u32, u32),
-) -> Result<()> {
+fn open(_args: ViewArgs, _scene: crate::render::scene::SceneSpec, _window_size: (u32, u32)) -> Result<()> {
     Err(Error::input("this lookdev was built without the viewer: rebuild with the default `viewer` feature"))
 }

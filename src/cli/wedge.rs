@@ -6,10 +6,11 @@ use super::progress::Progress;
 use crate::material::params::{check, Param, Value};
 use crate::material::Look;
 use crate::render::batch::Batch;
+use crate::render::scene::Scene;
 use crate::render::sheet;
 use crate::{Error, Result};
 use clap::Args;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct WedgeArgs {
@@ -97,15 +98,17 @@ pub fn run(args: WedgeArgs) -> Result<()> {
         None if args.lighting.env.is_some() => Look { environment: Default::default(), ..default_look() },
         None => default_look(),
     };
-    let (settings, environment, gbuffer) =
-        inputs::ball_inputs(&look, &args.lighting, &args.display, args.spp, &args.model, args.size)?;
+    let Scene { gbuffer, gbuffer_name, look, environment, settings, .. } =
+        Scene::load(&inputs::ball_spec(look, &args.lighting, &args.display, args.spp, &args.model, args.size))?;
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
     let rows = {
-        let mut batch = Batch::new(&ctx, &gbuffer, Path::new("built-in shader ball"), &environment)?;
+        let mut batch = Batch::new(&ctx, &gbuffer, &gbuffer_name, &environment)?;
         let mut progress = Progress::new((params.len() * values.len()) as u64, "wedge", args.quiet);
         let mut rows = Vec::new();
         for &param in &params {
+            // Every object is reached: the wedge's value is set on every layer, so the look
+            // needs a stack for every object, as `--set` gives it one.
             let mut row_look = look.clone();
             row_look.ensure_default_stack();
             let mut title = param.name().to_string();

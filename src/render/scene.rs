@@ -13,6 +13,35 @@ use std::path::{Path, PathBuf};
 /// Size of the built-in shader ball when no g-buffer is given.
 pub const BUILTIN_SIZE: u32 = 1024;
 
+/// What a render's inputs are, as a command or the viewer names them. Every command that
+/// renders and the viewer describe their inputs so, and [`Scene::load`] reads them: one way to
+/// choose the look, apply `--set`, resolve the settings, read the g-buffer or make the shader
+/// ball, load the environment and pack the stacks.
+#[derive(Clone, Debug, Default)]
+pub struct SceneSpec {
+    pub look: LookSource,
+    pub gbuffer: GBufferSpec,
+    /// `--set`: parameters set on every layer of every object.
+    pub sets: Vec<(Param, Value)>,
+    /// The command line's settings over the look's.
+    pub overrides: Overrides,
+    pub env_options: LoadOptions,
+    /// Leaves out the line saying what another renderer's g-buffer was read as.
+    pub quiet: bool,
+}
+
+/// Where a scene's look comes from.
+#[derive(Clone, Debug, Default)]
+pub enum LookSource {
+    /// The built-in default look on the built-in shader ball; the default material on a
+    /// g-buffer file.
+    #[default]
+    Default,
+    File(PathBuf),
+    /// A look made in memory (wedges and contact sheets start from one).
+    Given(Box<Look>),
+}
+
 /// Everything a render reads from files, validated.
 pub struct Scene {
     pub gbuffer: GBuffer,
@@ -25,66 +54,26 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// Packs the look's stacks for the objects in the g-buffer.
-    pub fn new(
-        gbuffer: GBuffer,
-        gbuffer_name: PathBuf,
-        look: Look,
-        environment: Environment,
-        settings: Settings,
-    ) -> Result<Scene> {
+    /// Reads and checks everything `spec` names, printing the warnings; see [`SceneSpec`].
+    pub fn load(spec: &SceneSpec) -> Result<Scene> {
+        let mut look = match &spec.look {
+            LookSource::File(path) => Look::load(path)?,
+            LookSource::Given(look) => (**look).clone(),
+            LookSource::Default if spec.gbuffer.file.is_none() => Look::builtin_default(),
+            LookSource::Default => Look::default_material(),
+        };
+        prepare_look(&mut look, &spec.sets)?;
+        let settings = Settings::resolve(&look, &spec.overrides)?;
+        let environment = load_environment(settings.environment.as_deref(), &spec.env_options)?;
+        let ReadGBuffer { gbuffer, name: gbuffer_name, claims } = read_gbuffer(&spec.gbuffer, &mut look, spec.quiet)?;
+        claims.into_iter().for_each(crate::warn);
         let covered = covered_object_ids(&gbuffer);
         let stacks = PackedStacks::pack(&look, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
-        unused_stack_warnings(&look, &covered, &gbuffer_name).into_iter().for_each(crate::warn);
+        look_warnings(&look, &covered, &gbuffer_name).into_iter().for_each(crate::warn);
         dark_render_warnings(&gbuffer, &gbuffer_name, &environment, settings.lighting.intensity)
             .into_iter()
             .for_each(crate::warn);
         Ok(Scene { gbuffer, gbuffer_name, look, environment, settings, stacks })
-    }
-
-    /// Reads a render's inputs. Without a g-buffer, the built-in shader ball; without a look, the
-    /// built-in default look for the shader ball, or the default material for a user g-buffer.
-    /// `sets` override parameters on every layer; `overrides` the look's settings.
-    pub fn load(
-        gbuffer: &GBufferSpec,
-        look: Option<&Path>,
-        sets: &[(Param, Value)],
-        overrides: &Overrides,
-        env_options: &LoadOptions,
-        quiet: bool,
-    ) -> Result<Scene> {
-        let mut look = match look {
-            Some(path) => Look::load(path)?,
-            None if gbuffer.file.is_none() => Look::builtin_default(),
-            None => Look::default_material(),
-        };
-        let had_stacks = !look.objects.is_empty();
-        let implicit_default = look.ensure_default_stack();
-        for (param, value) in sets {
-            look.set_everywhere(*param, *value).map_err(crate::Error::input)?;
-        }
-        let settings = Settings::resolve(&look, overrides)?;
-        let environment = match &settings.environment {
-            Some(path) => environment::load::load(path, env_options)?,
-            None => Environment::studio(),
-        };
-        let ReadGBuffer { gbuffer, name: gbuffer_name, claims } = read_gbuffer(gbuffer, &mut look, quiet)?;
-        claims.into_iter().for_each(crate::warn);
-        if implicit_default && had_stacks {
-            let unstyled: Vec<String> = covered_object_ids(&gbuffer)
-                .into_iter()
-                .filter(|id| !look.objects.iter().any(|o| o.id == Some(*id)))
-                .map(|id| id.to_string())
-                .collect();
-            if !unstyled.is_empty() {
-                let name = look.file.as_deref().map(|p| p.display().to_string()).unwrap_or_default();
-                crate::warn(format!(
-                    "{name}: object id {} has no stack and the look has no default stack; the default material is used",
-                    unstyled.join(", ")
-                ));
-            }
-        }
-        Scene::new(gbuffer, gbuffer_name, look, environment, settings)
     }
 
     /// Whether this device can hold the g-buffer: checked once the device is known, and
@@ -116,6 +105,59 @@ impl Scene {
 pub struct GBufferSpec {
     pub file: Option<PathBuf>,
     pub source: SourceOptions,
+    /// The built-in shader ball's size when no file is named ([`BUILTIN_SIZE`] square if
+    /// `None`).
+    pub builtin_size: Option<(u32, u32)>,
+}
+
+/// A look made ready to render with `sets`: with any, it gets a default stack if it has none,
+/// so that they reach every object as they reach every layer; then they are applied.
+pub fn prepare_look(look: &mut Look, sets: &[(Param, Value)]) -> Result<()> {
+    if !sets.is_empty() {
+        look.ensure_default_stack();
+    }
+    for (param, value) in sets {
+        look.set_everywhere(*param, *value).map_err(crate::Error::input)?;
+    }
+    Ok(())
+}
+
+/// A look file read for a g-buffer already read (the viewer opening a look, or its B look):
+/// prepared as [`Scene::load`] prepares looks, its object names resolved and its stacks packed,
+/// with the warnings for the caller to show its way.
+pub fn load_look_for(path: &Path, gbuffer: &GBuffer, gbuffer_name: &Path) -> Result<(Look, PackedStacks, Vec<String>)> {
+    let mut look = Look::load(path)?;
+    prepare_look(&mut look, &[])?;
+    let mut warnings = look.resolve_object_names(&gbuffer.object_names, gbuffer_name)?;
+    let covered = covered_object_ids(gbuffer);
+    let stacks = PackedStacks::pack(&look, covered.iter().copied(), gbuffer, gbuffer_name)?;
+    warnings.extend(look_warnings(&look, &covered, gbuffer_name));
+    Ok((look, stacks, warnings))
+}
+
+/// What may be unintended in how a look styles the covered objects: stacks for objects the
+/// g-buffer lacks, and objects left in the default material by a look with stacks but no
+/// default stack.
+pub fn look_warnings(look: &Look, covered: &[u32], gbuffer_name: &Path) -> Vec<String> {
+    let mut warnings = unused_stack_warnings(look, covered, gbuffer_name);
+    let stackless: Vec<String> =
+        covered.iter().filter(|&&id| look.stack_for(id).is_none()).map(|id| id.to_string()).collect();
+    if !look.objects.is_empty() && !stackless.is_empty() {
+        let name = look.file.as_deref().map(|p| p.display().to_string()).unwrap_or_default();
+        warnings.push(format!(
+            "{name}: object id {} has no stack and the look has no default stack; the default material is used",
+            stackless.join(", ")
+        ));
+    }
+    warnings
+}
+
+/// The environment a look's settings name, or the built-in studio.
+pub fn load_environment(path: Option<&Path>, options: &LoadOptions) -> Result<Environment> {
+    match path {
+        Some(path) => environment::load::load(path, options),
+        None => Ok(Environment::studio()),
+    }
 }
 
 /// A g-buffer as a render reads it.
@@ -141,7 +183,10 @@ pub fn read_gbuffer(spec: &GBufferSpec, look: &mut Look, quiet: bool) -> Result<
             read.warnings.into_iter().for_each(crate::warn);
             (read.gbuffer, path)
         }
-        None => (GBuffer::shaderball(BUILTIN_SIZE, BUILTIN_SIZE), PathBuf::from("built-in shader ball")),
+        None => {
+            let (width, height) = spec.builtin_size.unwrap_or((BUILTIN_SIZE, BUILTIN_SIZE));
+            (GBuffer::shaderball(width, height), PathBuf::from("built-in shader ball"))
+        }
     };
     let claims = look.resolve_object_names(&gbuffer.object_names, &name)?;
     Ok(ReadGBuffer { gbuffer, name, claims })

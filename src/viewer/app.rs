@@ -11,13 +11,9 @@ use super::session::Session;
 use super::thumbnails::{self, Thumbnails};
 use super::ui::{FileDialog, FilePurpose, Frame, FrameFigures, Interface, Pending};
 use super::ViewOptions;
-use crate::environment::{self, Environment};
-use crate::gbuffer::GBuffer;
 use crate::gpu::context::{Presentation, ValidationCounter};
 use crate::gpu::{Context, ContextOptions};
-use crate::material::stack::{unused_stack_warnings, PackedStacks};
-use crate::material::Look;
-use crate::render::scene::{covered_object_ids, dark_render_warnings, read_gbuffer, ReadGBuffer};
+use crate::render::scene::{covered_object_ids, load_look_for, LookSource, Scene};
 use crate::render::settings::{Overrides, Settings};
 use crate::viewer_state::{Document, Edit, ObjectRef, Selection};
 use crate::{Error, Result};
@@ -49,45 +45,25 @@ pub fn run(options: ViewOptions) -> Result<()> {
 
 /// The files read and checked before the window opens.
 struct Inputs {
-    gbuffer: GBuffer,
-    gbuffer_name: PathBuf,
+    scene: Scene,
     document: Document,
-    environment: Environment,
 }
 
 impl Inputs {
     fn load(options: &ViewOptions) -> Result<Inputs> {
-        let mut look = match &options.look {
-            Some(path) => Look::load(path)?,
-            None if options.gbuffer.file.is_none() => Look::builtin_default(),
-            None => Look::default_material(),
-        };
-        for (param, value) in &options.sets {
-            look.set_everywhere(*param, *value).map_err(Error::input)?;
-        }
-        let settings = Settings::resolve(&look, &options.overrides)?;
-        let environment = match &settings.environment {
-            Some(path) => environment::load::load(path, &options.env_options)?,
-            None => Environment::studio(),
-        };
-        let ReadGBuffer { gbuffer, name: gbuffer_name, claims } = read_gbuffer(&options.gbuffer, &mut look, false)?;
-        claims.into_iter().for_each(crate::warn);
-        let covered = covered_object_ids(&gbuffer);
-        PackedStacks::pack(&look, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
-        unused_stack_warnings(&look, &covered, &gbuffer_name).into_iter().for_each(crate::warn);
-        dark_render_warnings(&gbuffer, &gbuffer_name, &environment, settings.lighting.intensity)
-            .into_iter()
-            .for_each(crate::warn);
+        let scene = Scene::load(&options.scene)?;
         // B's inputs are checked here too, so that a bad one is an error before a window opens.
-        model_with(settings.model, &options.compare_model, "--compare-model")?;
+        model_with(scene.settings.model, &options.compare_model, "--compare-model")?;
         if let Some(path) = &options.compare_look {
-            let mut b = Look::load(path)?;
-            b.resolve_object_names(&gbuffer.object_names, &gbuffer_name)?;
-            PackedStacks::pack(&b, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
+            load_look_for(path, &scene.gbuffer, &scene.gbuffer_name)?;
         }
-        let mut document = Document::new(look, options.look.clone(), settings);
-        document.select(initial_selection(&document, &covered));
-        Ok(Inputs { gbuffer, gbuffer_name, document, environment })
+        let path = match &options.scene.look {
+            LookSource::File(path) => Some(path.clone()),
+            _ => None,
+        };
+        let mut document = Document::new(scene.look.clone(), path, scene.settings.clone());
+        document.select(initial_selection(&document, &covered_object_ids(&scene.gbuffer)));
+        Ok(Inputs { scene, document })
     }
 }
 
@@ -196,20 +172,15 @@ impl Running {
         let presenter = Presenter::new(&ctx, surface, size.width, size.height)?;
         let gui = Gui::new(&ctx, &window, &presenter)?;
         let thumbnails = Thumbnails::new(&ctx, thumbnails::cache_dir())?;
-        let max = ctx.info().max_image_dimension_2d;
-        if inputs.gbuffer.width > max || inputs.gbuffer.height > max {
-            return Err(Error::input_file(
-                &inputs.gbuffer_name,
-                format!("the g-buffer is larger than {}'s {max}-pixel image limit", ctx.info().name),
-            ));
-        }
+        inputs.scene.check_device(ctx.info())?;
+        let Inputs { scene, document } = inputs;
         let mut session = Session::new(
             &ctx,
-            inputs.gbuffer,
-            inputs.gbuffer_name,
-            inputs.document,
-            inputs.environment,
-            options.env_options,
+            scene.gbuffer,
+            scene.gbuffer_name,
+            document,
+            scene.environment,
+            options.scene.env_options,
         )?;
         if let Some(path) = &options.compare_look {
             session.compare_look(path)?;
@@ -541,10 +512,8 @@ impl Running {
     }
 
     fn open_look(&mut self, path: &Path) -> Result<Option<String>> {
-        let mut look = Look::load(path)?;
-        let mut warnings = look.resolve_object_names(&self.session.gbuffer.object_names, &self.session.gbuffer_name)?;
+        let (look, _, warnings) = load_look_for(path, &self.session.gbuffer, &self.session.gbuffer_name)?;
         let settings = Settings::resolve(&look, &Overrides::default())?;
-        warnings.extend(unused_stack_warnings(&look, self.session.objects(), &self.session.gbuffer_name));
         let mut document = Document::new(look, Some(path.to_path_buf()), settings);
         document.select(initial_selection(&document, self.session.objects()));
         self.session.replace_document(document)?;

@@ -22,21 +22,15 @@ mod ui;
 pub use action::Action;
 pub use script::{Script, Step};
 
-use crate::environment::LoadOptions;
-use crate::material::{Param, Value};
-use crate::render::scene::GBufferSpec;
-use crate::render::settings::Overrides;
+use crate::render::scene::SceneSpec;
 use crate::{Error, Result};
 use std::path::PathBuf;
 
 /// What `lookdev view` was asked to open, and how.
 #[derive(Clone, Debug, Default)]
 pub struct ViewOptions {
-    pub look: Option<PathBuf>,
-    pub gbuffer: GBufferSpec,
-    pub sets: Vec<(Param, Value)>,
-    pub overrides: Overrides,
-    pub env_options: LoadOptions,
+    /// What opens: the look, the g-buffer, `--set` and the flags over the look's settings.
+    pub scene: SceneSpec,
     pub device: Option<String>,
     /// The window's inner size in logical pixels.
     pub window_size: (u32, u32),

@@ -261,12 +261,8 @@ impl Session {
     /// Shows B: the look at `path`, its stacks and model under A's lighting and settings. A look
     /// that does not load or fit the g-buffer changes nothing.
     pub fn compare_look(&mut self, path: &Path) -> Result<()> {
-        let mut look = crate::material::Look::load(path)?;
-        look.resolve_object_names(&self.gbuffer.object_names, &self.gbuffer_name)?;
-        let packed = PackedStacks::pack(&look, self.objects.iter().copied(), &self.gbuffer, &self.gbuffer_name)?;
-        crate::material::stack::unused_stack_warnings(&look, &self.objects, &self.gbuffer_name)
-            .into_iter()
-            .for_each(crate::warn);
+        let (look, packed, warnings) = crate::render::scene::load_look_for(path, &self.gbuffer, &self.gbuffer_name)?;
+        warnings.into_iter().for_each(crate::warn);
         self.start_compare(Subject::Look { path: path.to_path_buf(), look: Box::new(look) }, packed)
     }
 
