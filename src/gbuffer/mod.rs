@@ -66,6 +66,7 @@
 //! renamed into place. [`GBuffer::shaderball`] makes the built-in look-dev scene without a file.
 
 mod frame;
+pub mod gpu;
 mod procedural;
 mod read;
 mod scene;

@@ -5,6 +5,7 @@ pub mod batch;
 pub mod compare;
 pub mod energy;
 pub mod output;
+pub mod passes;
 pub mod progressive;
 pub mod renderer;
 pub mod scene;

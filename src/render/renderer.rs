@@ -1,23 +1,23 @@
 //! The relighting engine: g-buffer, environment and layer stacks on the GPU; resolve, progressive
 //! relight passes, and display transforms. Every command that renders drives it.
 
-use crate::environment::{self, Distribution, Environment, GpuEnvironment};
-use crate::gbuffer::{GBuffer, MAP_PREFIX, MASK_PREFIX};
-use crate::gpu::pipeline::group_count;
-use crate::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, GpuTimer, Image};
+use super::passes::finalize::{FinalizePass, FinalizePush};
+use super::passes::relight::RelightPass;
+use super::passes::resolve::ResolvePass;
+use super::passes::Targets;
+use crate::environment::{Distribution, Environment, GpuEnvironment};
+use crate::gbuffer::gpu::GpuGBuffer;
+use crate::gbuffer::GBuffer;
+use crate::gpu::{Buffer, Context, GpuTimer, Image};
 use crate::material::stack::PackedStacks;
 use crate::render::tonemap::Tonemap;
 use crate::shading::brdf::Shading;
-use crate::shading::energy::EnergyTable;
 use crate::shading::model::Model;
 use crate::Result;
 use ash::vk;
-use std::collections::BTreeMap;
-use std::sync::Arc;
 
-/// Workgroup size of the 2D kernels (`local_size_x`, `local_size_y` in glsl/*.comp).
-const LOCAL_SIZE_X: u32 = 16;
-const LOCAL_SIZE_Y: u32 = 16;
+pub use super::passes::relight::{Accumulate, RelightPush, LOBES};
+pub use super::passes::RESOLVED_LAYERS;
 
 /// How the environment lights the scene. Any change restarts accumulation.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,148 +35,23 @@ impl Default for Lighting {
     }
 }
 
-/// `Pass` in relight.comp.
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct RelightPush {
-    first_sample: u32,
-    sample_count: u32,
-    seed: u32,
-    show_background: u32,
-    cos_rotation: f32,
-    sin_rotation: f32,
-    intensity: f32,
-    first_row: u32,
-    end_row: u32,
-}
-
-/// What the relight kernel accumulates beside the total, for the AOVs that need it
-/// (docs/formats.md: AOVs). What is off costs nothing: the kernel is specialised without it,
-/// and a 1×1 placeholder stands for its image.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Accumulate {
-    /// Each lobe's share of every estimate: diffuse, specular, clearcoat, sheen.
-    pub lobes: bool,
-    /// Each estimate's squared luminance, for the variance of the mean.
-    pub variance: bool,
-}
-
-/// The layers of the lobe sums, in `relight.comp`'s order.
-pub const LOBES: [&str; 4] = ["diffuse", "specular", "clearcoat", "sheen"];
-
-/// `Finalize` in finalize.comp.
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct FinalizePush {
-    exposure_scale: f32,
-    tonemap: u32,
-    show_background: u32,
-    first_row: u32,
-    end_row: u32,
-}
-
-/// The per-object material inputs on the GPU: which stack each pixel uses and the layers. Held
-/// only to keep them alive while the resolve set points at them.
-struct GpuStacks {
-    _stack_index: Image,
-    _stacks: Buffer,
-    _layers: Buffer,
-    _set: DescriptorSet,
-}
-
-/// A relighting session for one g-buffer.
+/// A relighting session for one g-buffer: the g-buffer, environment and layer stacks on the
+/// GPU, and the three passes over them (see [`super::passes`]).
 pub struct Renderer {
     ctx: Context,
     pub width: u32,
     pub height: u32,
-    resolve: ComputePipeline,
-    relight: ComputePipeline,
-    finalize: ComputePipeline,
-    /// The BRDF model the relight pipeline is specialized for, with its energy table.
-    shading: Shading,
-    // Held so the GPU resources that descriptor sets point at stay alive.
-    _energy: Buffer,
-    accumulate: Accumulate,
-    /// The lobe sums (4 layers) and the squared luminances, or 1×1 placeholders.
-    lobe_sums: Image,
-    moments: Image,
-    resolved: Image,
-    background: Image,
-    accumulation: Image,
-    surface: Image,
-    radiance: Image,
-    display: Image,
-    object_ids: Vec<u32>,
-    /// The g-buffer's masks and maps by full channel name, for the stacks to choose from.
-    channels: BTreeMap<String, Vec<f32>>,
-    stacks: Option<GpuStacks>,
-    /// The mask and map channels the stacks read, one layer each, and their names: kept while
-    /// edits leave the list alone, so that changing a value uploads no channel again.
-    channel_layers: Option<(Vec<String>, Image)>,
-    _environment: GpuEnvironment,
-    environment_set: DescriptorSet,
-    relight_set: DescriptorSet,
-    finalize_set: DescriptorSet,
+    gbuffer: GpuGBuffer,
+    environment: GpuEnvironment,
+    targets: Targets,
+    resolve: ResolvePass,
+    relight: RelightPass,
+    finalize: FinalizePass,
     timer: Option<GpuTimer>,
     lighting: Lighting,
     seed: u32,
     /// Samples each row has in the current accumulation.
     row_samples: Vec<u32>,
-}
-
-/// The resolved material's layers: the five vec4s of `Params::to_gpu`.
-pub const RESOLVED_LAYERS: u32 = (crate::material::params::GPU_FLOATS / 4) as u32;
-
-/// The g-buffer's masks and maps, keyed by their full channel names as packed stacks name them.
-fn layer_channels(gbuffer: &GBuffer) -> BTreeMap<String, Vec<f32>> {
-    let masks = gbuffer.masks.iter().map(|(name, values)| (format!("{MASK_PREFIX}{name}"), values.clone()));
-    let maps = gbuffer.maps.iter().map(|(name, values)| (format!("{MAP_PREFIX}{name}"), values.clone()));
-    masks.chain(maps).collect()
-}
-
-fn float_image(ctx: &Context, width: u32, height: u32, layers: u32, data: &[[f32; 4]]) -> Result<Image> {
-    let image = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, layers, layers > 1)?;
-    image.upload(ctx, bytemuck::cast_slice(data))?;
-    Ok(image)
-}
-
-/// The images `accumulate` needs: the lobe sums (4 layers) and the squared luminances, each
-/// 1×1 when not asked for.
-fn accumulation_images(ctx: &Context, width: u32, height: u32, accumulate: Accumulate) -> Result<(Image, Image)> {
-    let size = |on: bool| if on { (width, height) } else { (1, 1) };
-    let (w, h) = size(accumulate.lobes);
-    let lobes = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, w, h, LOBES.len() as u32, true)?;
-    let (w, h) = size(accumulate.variance);
-    let moments = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, w, h, 1, false)?;
-    Ok((lobes, moments))
-}
-
-/// The relight pipeline for a model, and the energy table it reads (a placeholder unless the
-/// model compensates energy; the table itself is built on the GPU).
-fn relight_pipeline(
-    ctx: &Context,
-    model: &Model,
-    accumulate: Accumulate,
-) -> Result<(ComputePipeline, Shading, Buffer)> {
-    let image = BindingKind::StorageImage;
-    let buffer = BindingKind::StorageBuffer;
-    let mut constants = model.specialization().to_vec();
-    constants.extend([accumulate.lobes as u32, accumulate.variance as u32]);
-    let relight = ComputePipeline::specialized(
-        ctx,
-        &shaders::RELIGHT,
-        &[&[image, image, image, image, buffer, image, image], &environment::gpu::SET_LAYOUT],
-        std::mem::size_of::<RelightPush>() as u32,
-        &constants,
-    )?;
-    let (table, energy) = if model.energy_compensation {
-        let table = crate::render::energy::build(ctx, model)?;
-        (table.clone(), Some(Arc::new(table)))
-    } else {
-        (EnergyTable::placeholder(), None)
-    };
-    let energy_buffer = Buffer::with_data(ctx, bytemuck::cast_slice(&table.values))?;
-    Ok((relight, Shading::new(*model, energy), energy_buffer))
 }
 
 impl Renderer {
@@ -188,79 +63,23 @@ impl Renderer {
     /// A renderer of a BRDF model (docs/shading.md: BRDF models).
     pub fn with_model(ctx: &Context, gbuffer: &GBuffer, environment: &Environment, model: &Model) -> Result<Renderer> {
         let (width, height) = (gbuffer.width, gbuffer.height);
-        let image = BindingKind::StorageImage;
-        let buffer = BindingKind::StorageBuffer;
-        let resolve = ComputePipeline::new(ctx, &shaders::RESOLVE, &[&[image, image, buffer, buffer, image]], 0)?;
+        let gpu_gbuffer = GpuGBuffer::upload(ctx, gbuffer)?;
         let accumulate = Accumulate::default();
-        let (relight, shading, energy) = relight_pipeline(ctx, model, accumulate)?;
-        let finalize =
-            ComputePipeline::new(ctx, &shaders::FINALIZE, &[&[image; 5]], std::mem::size_of::<FinalizePush>() as u32)?;
-
-        let mut surface_data = Vec::with_capacity(3 * gbuffer.pixel_count());
-        surface_data.extend(gbuffer.normal.iter().zip(&gbuffer.coverage).map(|(n, a)| [n[0], n[1], n[2], *a]));
-        surface_data.extend(gbuffer.view.iter().map(|v| [v[0], v[1], v[2], 0.0]));
-        surface_data.extend(gbuffer.tangent.iter().map(|t| [t[0], t[1], t[2], 0.0]));
-        let surface = float_image(ctx, width, height, 3, &surface_data)?;
-        let resolved = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, RESOLVED_LAYERS, true)?;
-        let float_target = || Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 1, false);
-        let accumulation = float_target()?;
-        let background = float_target()?;
-
-        let radiance = float_target()?;
-        let display = Image::display(ctx, width, height)?;
-
-        let distribution = Distribution::for_device(environment, ctx.info().max_image_dimension_2d);
-        let gpu_environment = GpuEnvironment::upload(ctx, environment, &distribution)?;
-        let environment_set = relight.bind(1, &gpu_environment.bindings())?;
-        let (lobe_sums, moments) = accumulation_images(ctx, width, height, accumulate)?;
-        let relight_set = relight.bind(
-            0,
-            &[
-                Binding::Image(&surface),
-                Binding::Image(&resolved),
-                Binding::Image(&accumulation),
-                Binding::Image(&background),
-                Binding::Buffer(&energy),
-                Binding::Image(&lobe_sums),
-                Binding::Image(&moments),
-            ],
-        )?;
-        let finalize_set = finalize.bind(
-            0,
-            &[
-                Binding::Image(&accumulation),
-                Binding::Image(&background),
-                Binding::Image(&surface),
-                Binding::Image(&radiance),
-                Binding::Image(&display),
-            ],
-        )?;
+        let targets = Targets::new(ctx, width, height, accumulate)?;
+        let gpu_environment = upload_environment(ctx, environment)?;
+        let resolve = ResolvePass::new(ctx)?;
+        let relight = RelightPass::new(ctx, model, accumulate, &gpu_gbuffer, &targets, &gpu_environment)?;
+        let finalize = FinalizePass::new(ctx, &gpu_gbuffer, &targets)?;
         Ok(Renderer {
             ctx: ctx.clone(),
             width,
             height,
+            gbuffer: gpu_gbuffer,
+            environment: gpu_environment,
+            targets,
             resolve,
             relight,
             finalize,
-            shading,
-            _energy: energy,
-            accumulate,
-            lobe_sums,
-            moments,
-            resolved,
-            accumulation,
-            background,
-            surface,
-            radiance,
-            display,
-            object_ids: gbuffer.object_id.clone(),
-            channels: layer_channels(gbuffer),
-            stacks: None,
-            channel_layers: None,
-            _environment: gpu_environment,
-            environment_set,
-            relight_set,
-            finalize_set,
             timer: GpuTimer::new(ctx, 2)?,
             lighting: Lighting::default(),
             seed: 0,
@@ -270,62 +89,41 @@ impl Renderer {
 
     /// Replaces the environment (its texels and sampling tables); accumulation restarts.
     pub fn set_environment(&mut self, environment: &Environment) -> Result<()> {
-        let distribution = Distribution::for_device(environment, self.ctx.info().max_image_dimension_2d);
-        let gpu_environment = GpuEnvironment::upload(&self.ctx, environment, &distribution)?;
-        self.environment_set = self.relight.bind(1, &gpu_environment.bindings())?;
-        self._environment = gpu_environment;
+        let gpu_environment = upload_environment(&self.ctx, environment)?;
+        self.relight.set_environment(&gpu_environment)?;
+        self.environment = gpu_environment;
         self.restart();
         Ok(())
     }
 
     /// The BRDF model being rendered, with its energy table when it has one.
     pub fn shading(&self) -> &Shading {
-        &self.shading
+        &self.relight.shading
     }
 
     /// Switches the BRDF model: a new specialization of the relight kernel (and energy table);
     /// accumulation restarts. Nothing happens when the model is the same.
     pub fn set_model(&mut self, model: &Model) -> Result<()> {
-        if *model == self.shading.model {
+        if *model == self.relight.shading.model {
             return Ok(());
         }
-        self.respecialize(*model, self.accumulate)
+        self.respecialize(*model, self.relight.accumulate)
     }
 
     /// What the relight kernel accumulates beside the total (for the AOVs that need it), with
     /// its images; accumulation restarts. Nothing happens when it is the same.
     pub fn set_accumulate(&mut self, accumulate: Accumulate) -> Result<()> {
-        if accumulate == self.accumulate {
+        if accumulate == self.relight.accumulate {
             return Ok(());
         }
-        let (lobe_sums, moments) = accumulation_images(&self.ctx, self.width, self.height, accumulate)?;
-        self.lobe_sums = lobe_sums;
-        self.moments = moments;
-        self.respecialize(self.shading.model, accumulate)
+        self.targets.set_accumulate(&self.ctx, accumulate)?;
+        self.respecialize(self.relight.shading.model, accumulate)
     }
 
-    /// A new relight kernel for this model and accumulation, bound to the renderer's images.
+    /// A new relight pass for this model and accumulation.
     fn respecialize(&mut self, model: Model, accumulate: Accumulate) -> Result<()> {
-        let (relight, shading, energy) = relight_pipeline(&self.ctx, &model, accumulate)?;
-        let environment_set = relight.bind(1, &self._environment.bindings())?;
-        let relight_set = relight.bind(
-            0,
-            &[
-                Binding::Image(&self.surface),
-                Binding::Image(&self.resolved),
-                Binding::Image(&self.accumulation),
-                Binding::Image(&self.background),
-                Binding::Buffer(&energy),
-                Binding::Image(&self.lobe_sums),
-                Binding::Image(&self.moments),
-            ],
-        )?;
-        self.relight_set = relight_set;
-        self.environment_set = environment_set;
-        self.relight = relight;
-        self.shading = shading;
-        self._energy = energy;
-        self.accumulate = accumulate;
+        self.relight =
+            RelightPass::new(&self.ctx, &model, accumulate, &self.gbuffer, &self.targets, &self.environment)?;
         self.restart();
         Ok(())
     }
@@ -372,42 +170,9 @@ impl Renderer {
     /// Uploads new layer stacks and resolves them into one material per pixel (once per edit,
     /// not per sample). Accumulation restarts.
     pub fn set_stacks(&mut self, packed: &PackedStacks) -> Result<()> {
-        let ctx = &self.ctx;
+        self.resolve.set_stacks(&self.ctx, &mut self.gbuffer, packed, &self.targets)?;
         let (width, height) = (self.width, self.height);
-        let pixels = self.object_ids.len();
-        // Uncovered pixels may carry ids the stacks leave out; they shade nothing, so stack 0 does.
-        let index: Vec<u32> =
-            self.object_ids.iter().map(|id| packed.stack_of_object.get(id).copied().unwrap_or(0)).collect();
-        let stack_index = Image::new(ctx, vk::Format::R32_UINT, width, height, 1, false)?;
-        stack_index.upload(ctx, bytemuck::cast_slice(&index))?;
-        if self.channel_layers.as_ref().is_none_or(|(names, _)| *names != packed.channels) {
-            // At least one channel layer, so the binding is always valid.
-            let layers = packed.channels.len().max(1) as u32;
-            let mut channel_data = vec![0.0f32; pixels * layers as usize];
-            for (i, name) in packed.channels.iter().enumerate() {
-                let values = self.channels.get(name).expect("pack() checked the masks and maps");
-                channel_data[i * pixels..(i + 1) * pixels].copy_from_slice(values);
-            }
-            let image = Image::new(ctx, vk::Format::R32_SFLOAT, width, height, layers, true)?;
-            image.upload(ctx, bytemuck::cast_slice(&channel_data))?;
-            self.channel_layers = Some((packed.channels.clone(), image));
-        }
-        let (_, channels) = self.channel_layers.as_ref().expect("just made");
-        let stacks = Buffer::with_data(ctx, bytemuck::cast_slice(&packed.stacks))?;
-        let layer_buffer = Buffer::with_data(ctx, bytemuck::cast_slice(&packed.layers))?;
-        let set = self.resolve.bind(
-            0,
-            &[
-                Binding::Image(&stack_index),
-                Binding::Image(channels),
-                Binding::Buffer(&stacks),
-                Binding::Buffer(&layer_buffer),
-                Binding::Image(&self.resolved),
-            ],
-        )?;
-        let groups = [group_count(width, LOCAL_SIZE_X), group_count(height, LOCAL_SIZE_Y), 1];
-        self.timed(|renderer, cmd| renderer.resolve.dispatch(cmd, &[&set], &[], groups))?;
-        self.stacks = Some(GpuStacks { _stack_index: stack_index, _stacks: stacks, _layers: layer_buffer, _set: set });
+        self.timed(|renderer, cmd| renderer.resolve.record(cmd, width, height))?;
         self.restart();
         Ok(())
     }
@@ -441,7 +206,7 @@ impl Renderer {
     /// differ by a pass; [`Renderer::samples`] counts what every row has. Rows with different
     /// counts take a dispatch each (usually there is one). Returns the GPU time.
     pub fn render_rows(&mut self, first_row: u32, rows: u32, count: u32) -> Result<Option<f64>> {
-        assert!(self.stacks.is_some(), "set_stacks() must run before rendering");
+        assert!(self.resolve.has_stacks(), "set_stacks() must run before rendering");
         let end = first_row.saturating_add(rows).min(self.height);
         let mut total = Some(0.0);
         let mut start = first_row;
@@ -469,15 +234,7 @@ impl Renderer {
             first_row,
             end_row,
         };
-        let groups = [group_count(self.width, LOCAL_SIZE_X), group_count(end_row - first_row, LOCAL_SIZE_Y), 1];
-        self.timed(|renderer, cmd| {
-            renderer.relight.dispatch(
-                cmd,
-                &[&renderer.relight_set, &renderer.environment_set],
-                bytemuck::bytes_of(&push),
-                groups,
-            )
-        })
+        self.timed(|renderer, cmd| renderer.relight.record(cmd, renderer.width, &push))
     }
 
     /// Reading the image before the first pass would show whatever an earlier accumulation left.
@@ -498,9 +255,7 @@ impl Renderer {
             first_row,
             end_row: first_row + rows.min(self.height.saturating_sub(first_row)),
         };
-        let rows = rows.min(self.height.saturating_sub(first_row));
-        let groups = [group_count(self.width, LOCAL_SIZE_X), group_count(rows, LOCAL_SIZE_Y), 1];
-        self.finalize.dispatch(cmd, &[&self.finalize_set], bytemuck::bytes_of(&push), groups);
+        self.finalize.record(cmd, self.width, &push);
         crate::gpu::context::full_barrier(&self.ctx.device, cmd);
     }
 
@@ -515,20 +270,20 @@ impl Renderer {
 
     /// The display image (sRGB-encoded RGBA8), which the viewer samples through its sRGB view.
     pub fn display_image(&self) -> &Image {
-        &self.display
+        &self.targets.display
     }
 
     /// Linear radiance per pixel, row 0 at the top: rgb composited over the background with
     /// alpha 1, or, with the background off, premultiplied by coverage with alpha = coverage.
     pub fn read_radiance(&self) -> Result<Vec<[f32; 4]>> {
         self.check_rendered()?;
-        let staging = Buffer::staging(&self.ctx, self.radiance.byte_size())?;
+        let staging = Buffer::staging(&self.ctx, self.targets.radiance.byte_size())?;
         self.ctx.run(|cmd| {
             self.record_finalize(cmd, 0, self.height, 0.0, Tonemap::Linear);
-            self.radiance.record_read(cmd, &staging);
+            self.targets.radiance.record_read(cmd, &staging);
             Ok(())
         })?;
-        Ok(bytemuck::cast_slice(&staging.bytes()[..self.radiance.byte_size() as usize]).to_vec())
+        Ok(bytemuck::cast_slice(&staging.bytes()[..self.targets.radiance.byte_size() as usize]).to_vec())
     }
 
     /// The linear radiance of one pixel, as [`Renderer::read_radiance`] gives it. Its row's
@@ -538,7 +293,7 @@ impl Renderer {
         let staging = Buffer::staging(&self.ctx, 16)?;
         self.ctx.run(|cmd| {
             self.record_finalize(cmd, y, 1, exposure, tonemap);
-            self.radiance.record_read_texel(cmd, &staging, x, y);
+            self.targets.radiance.record_read_texel(cmd, &staging, x, y);
             Ok(())
         })?;
         Ok(bytemuck::pod_read_unaligned(&staging.bytes()[..16]))
@@ -548,28 +303,28 @@ impl Renderer {
     /// the background is off, opaque otherwise.
     pub fn read_display(&self, exposure: f32, tonemap: Tonemap) -> Result<Vec<u8>> {
         self.check_rendered()?;
-        let staging = Buffer::staging(&self.ctx, self.display.byte_size())?;
+        let staging = Buffer::staging(&self.ctx, self.targets.display.byte_size())?;
         self.ctx.run(|cmd| {
             self.record_finalize(cmd, 0, self.height, exposure, tonemap);
-            self.display.record_read(cmd, &staging);
+            self.targets.display.record_read(cmd, &staging);
             Ok(())
         })?;
-        Ok(staging.bytes()[..self.display.byte_size() as usize].to_vec())
+        Ok(staging.bytes()[..self.targets.display.byte_size() as usize].to_vec())
     }
 
     /// The running sums (rgb) and sample counts (a) of the covered pixels; uncovered pixels hold
     /// whatever was last written there.
     fn read_sums(&self) -> Result<Vec<[f32; 4]>> {
         self.check_rendered()?;
-        Ok(bytemuck::cast_slice(&self.accumulation.read(&self.ctx)?).to_vec())
+        Ok(bytemuck::cast_slice(&self.targets.accumulation.read(&self.ctx)?).to_vec())
     }
 
     /// Each lobe's mean share of the estimate per pixel ([`LOBES`] order), not yet weighted by
     /// coverage: zero where no sample was taken. Needs [`Accumulate::lobes`].
     pub fn read_lobes(&self, coverage: &[f32]) -> Result<Vec<Vec<[f32; 3]>>> {
-        assert!(self.accumulate.lobes, "read_lobes() needs Accumulate::lobes");
+        assert!(self.relight.accumulate.lobes, "read_lobes() needs Accumulate::lobes");
         let sums = self.read_sums()?;
-        let layers: Vec<[f32; 4]> = bytemuck::cast_slice(&self.lobe_sums.read(&self.ctx)?).to_vec();
+        let layers: Vec<[f32; 4]> = bytemuck::cast_slice(&self.targets.lobe_sums.read(&self.ctx)?).to_vec();
         let pixels = sums.len();
         Ok((0..LOBES.len())
             .map(|k| {
@@ -591,9 +346,9 @@ impl Renderer {
     /// their squares: (Σx² − (Σx)²/n) / (n(n − 1)); zero with fewer than two samples. Needs
     /// [`Accumulate::variance`].
     pub fn read_variance(&self, coverage: &[f32]) -> Result<Vec<f32>> {
-        assert!(self.accumulate.variance, "read_variance() needs Accumulate::variance");
+        assert!(self.relight.accumulate.variance, "read_variance() needs Accumulate::variance");
         let sums = self.read_sums()?;
-        let squares: Vec<[f32; 4]> = bytemuck::cast_slice(&self.moments.read(&self.ctx)?).to_vec();
+        let squares: Vec<[f32; 4]> = bytemuck::cast_slice(&self.targets.moments.read(&self.ctx)?).to_vec();
         Ok(sums
             .iter()
             .zip(&squares)
@@ -612,6 +367,12 @@ impl Renderer {
     /// The resolved material per pixel, as [`RESOLVED_LAYERS`] layers of vec4 in the layout of
     /// [`crate::material::Params::to_gpu`] (for tests and inspection).
     pub fn read_resolved(&self) -> Result<Vec<[f32; 4]>> {
-        Ok(bytemuck::cast_slice(&self.resolved.read(&self.ctx)?).to_vec())
+        Ok(bytemuck::cast_slice(&self.targets.resolved.read(&self.ctx)?).to_vec())
     }
+}
+
+/// An environment with its sampling tables, on the GPU.
+fn upload_environment(ctx: &Context, environment: &Environment) -> Result<GpuEnvironment> {
+    let distribution = Distribution::for_device(environment, ctx.info().max_image_dimension_2d);
+    GpuEnvironment::upload(ctx, environment, &distribution)
 }

@@ -1,0 +1,54 @@
+//! The finalize pass (`finalize.comp`): each pixel's mean, composited over the background, as
+//! linear radiance and as display pixels (exposure, tone map, sRGB).
+
+use super::{groups, Targets};
+use crate::gbuffer::gpu::GpuGBuffer;
+use crate::gpu::{shaders, Binding, BindingKind, ComputePipeline, Context, DescriptorSet};
+use crate::Result;
+use ash::vk;
+
+/// Set 0 of `finalize.comp`: accumulation, background, surface, radiance, display.
+pub const SET: [BindingKind; 5] = [BindingKind::StorageImage; 5];
+
+/// `Finalize` in finalize.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FinalizePush {
+    /// 2^EV.
+    pub exposure_scale: f32,
+    /// [`crate::render::tonemap::Tonemap::gpu_id`].
+    pub tonemap: u32,
+    pub show_background: u32,
+    /// The band this dispatch covers: rows `first_row..end_row`.
+    pub first_row: u32,
+    pub end_row: u32,
+}
+
+pub struct FinalizePass {
+    pipeline: ComputePipeline,
+    set: DescriptorSet,
+}
+
+impl FinalizePass {
+    pub fn new(ctx: &Context, gbuffer: &GpuGBuffer, targets: &Targets) -> Result<FinalizePass> {
+        let size = std::mem::size_of::<FinalizePush>() as u32;
+        let pipeline = ComputePipeline::new(ctx, &shaders::FINALIZE, &[&SET], size)?;
+        let set = pipeline.bind(
+            0,
+            &[
+                Binding::Image(&targets.accumulation),
+                Binding::Image(&targets.background),
+                Binding::Image(&gbuffer.surface),
+                Binding::Image(&targets.radiance),
+                Binding::Image(&targets.display),
+            ],
+        )?;
+        Ok(FinalizePass { pipeline, set })
+    }
+
+    /// Records the pass over `width` pixels of the rows `push` names.
+    pub fn record(&self, cmd: vk::CommandBuffer, width: u32, push: &FinalizePush) {
+        let rows = push.end_row.saturating_sub(push.first_row);
+        self.pipeline.dispatch(cmd, &[&self.set], bytemuck::bytes_of(push), groups(width, rows));
+    }
+}
