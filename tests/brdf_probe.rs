@@ -3,22 +3,14 @@
 
 mod common;
 
+use common::probes::{self, Record};
 use common::random::Random;
 use glam::Vec3;
-use lookdev::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context};
+use lookdev::gpu::{shaders, Binding, Buffer, ComputePipeline, Context};
 use lookdev::material::{Param, Params};
 use lookdev::shading::brdf::{disney_brdf, make_half_vector, make_lobes_with, make_view, Shading};
 use lookdev::shading::model::{Diffuse, Model};
 use lookdev::shading::sampling::{brdf_pdf, choose_lobes};
-
-/// One probe record, laid out as `Record` in brdf_probe.comp.
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct Record {
-    params: [f32; 16],
-    l: [f32; 4],
-    v: [f32; 4],
-}
 
 fn random_params(rng: &mut Random) -> Params {
     let mut p = Params::default();
@@ -49,8 +41,8 @@ fn probe_model(ctx: &Context, model: &Model, records: &[Record]) -> (Vec<[f32; 4
     let pipeline = ComputePipeline::specialized(
         ctx,
         &shaders::BRDF_PROBE,
-        &[&[BindingKind::StorageBuffer; 3]],
-        0,
+        probes::BRDF_PROBE.sets,
+        probes::BRDF_PROBE.push_size(),
         &model.specialization(),
     )
     .unwrap();

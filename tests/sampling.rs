@@ -5,12 +5,13 @@
 
 mod common;
 
+use common::probes::{self, Setup};
 use common::random::Random;
 use common::stats::chi_square;
 use glam::{Vec2, Vec3};
 use lookdev::environment::distribution::row_cos;
 use lookdev::environment::{self, Distribution, Environment, GpuEnvironment};
-use lookdev::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context};
+use lookdev::gpu::{shaders, Binding, Buffer, ComputePipeline, Context};
 use lookdev::material::Params;
 use lookdev::shading::brdf::{make_half_vector, make_lobes, make_lobes_with, make_view, Lobes, Shading};
 use lookdev::shading::model::Model;
@@ -23,17 +24,6 @@ const BRDF: u32 = 3;
 const ENVIRONMENT: u32 = 4;
 const SOBOL: u32 = 5;
 const UV_ROUND_TRIP: u32 = 6;
-
-/// `Setup` of sample_probe.comp.
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct Setup {
-    params: [f32; 16],
-    view: [f32; 4],
-    routine: u32,
-    seed: u32,
-    pad: [u32; 2],
-}
 
 struct Probe {
     ctx: Context,
@@ -49,12 +39,11 @@ impl Probe {
 
     /// The probe specialized for a BRDF model, on `ctx`.
     fn with_model(ctx: Context, model: &Model) -> Probe {
-        let buffers = [BindingKind::StorageBuffer; 4];
         let pipeline = ComputePipeline::specialized(
             &ctx,
             &shaders::SAMPLE_PROBE,
-            &[&buffers, &environment::gpu::SET_LAYOUT],
-            0,
+            probes::SAMPLE_PROBE.sets,
+            probes::SAMPLE_PROBE.push_size(),
             &model.specialization(),
         )
         .unwrap();

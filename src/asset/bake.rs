@@ -17,8 +17,9 @@ use super::textures::{self, Slot, SLOTS};
 use super::Asset;
 use crate::gbuffer::stable_tangent;
 use crate::gbuffer::GBuffer;
-use crate::gpu::graphics::{Attribute, GraphicsPipeline, PipelineDesc, Sampler, SamplerDesc, TextureSet};
-use crate::gpu::{shaders, Buffer, Context, Image};
+use crate::gpu::graphics::{self, Attribute, GraphicsPipeline, PipelineDesc, Sampler, SamplerDesc, TextureSet};
+use crate::gpu::shaders::{self, Stage};
+use crate::gpu::{BindingKind, Buffer, Context, GlslLayout, GlslStruct, Image, Interface};
 use crate::{Error, Result};
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
@@ -58,7 +59,8 @@ struct GpuTextureSlot {
     v: [f32; 4],
     tex_coord: u32,
     present: u32,
-    pad: [u32; 2],
+    pad0: u32,
+    pad1: u32,
 }
 
 /// `Material` in glsl/include/bake_material.glsl (std430, 512 bytes).
@@ -71,7 +73,8 @@ struct GpuMaterial {
     anisotropy_cos: f32,
     anisotropy_sin: f32,
     clearcoat_roughness: f32,
-    pad: [f32; 2],
+    pad0: f32,
+    pad1: f32,
     base_color_factor: [f32; 4],
     sheen_color_factor: [f32; 4],
     specular_color_factor: [f32; 4],
@@ -101,10 +104,74 @@ const MAP_TARGETS: [vk::Format; 5] = [
     vk::Format::R32_UINT, // the material's index + 1; 0 for none
 ];
 
-/// The GPU layouts, as the GLSL declares them (std430 and push constants).
-const _: () = assert!(std::mem::size_of::<GpuMaterial>() == 512);
-const _: () = assert!(std::mem::size_of::<GpuTextureSlot>() == 48);
-const _: () = assert!(std::mem::size_of::<DrawConstants>() == 108);
+crate::glsl_struct!(DrawConstants as "Draw", 108 bytes {
+    view_projection @ 0,
+    eye @ 64,
+    toward_eye @ 80,
+    object_id @ 96,
+    material @ 100,
+    lod_bias @ 104,
+});
+crate::glsl_struct!(GpuTextureSlot as "TextureSlot", 48 bytes {
+    u @ 0,
+    v @ 16,
+    tex_coord @ 32,
+    present @ 36,
+    pad0 @ 40,
+    pad1 @ 44,
+});
+crate::glsl_struct!(GpuMaterial as "Material", 512 bytes {
+    flags @ 0,
+    alpha_cutoff @ 4,
+    normal_scale @ 8,
+    anisotropy_cos @ 12,
+    anisotropy_sin @ 16,
+    clearcoat_roughness @ 20,
+    pad0 @ 24,
+    pad1 @ 28,
+    base_color_factor @ 32,
+    sheen_color_factor @ 48,
+    specular_color_factor @ 64,
+    slots @ 80,
+});
+
+/// [`Vertex`] as bake.vert reads it, location by location.
+const VERTEX_ATTRIBUTES: [Attribute; 6] = {
+    use std::mem::offset_of;
+    const fn attribute(location: u32, format: vk::Format, offset: usize) -> Attribute {
+        Attribute { location, format, offset: offset as u32 }
+    }
+    [
+        attribute(0, vk::Format::R32G32B32_SFLOAT, offset_of!(Vertex, position)),
+        attribute(1, vk::Format::R32G32B32_SFLOAT, offset_of!(Vertex, normal)),
+        attribute(2, vk::Format::R32G32B32A32_SFLOAT, offset_of!(Vertex, tangent)),
+        attribute(3, vk::Format::R32G32_SFLOAT, offset_of!(Vertex, uv0)),
+        attribute(4, vk::Format::R32G32_SFLOAT, offset_of!(Vertex, uv1)),
+        attribute(5, vk::Format::R32G32B32A32_SFLOAT, offset_of!(Vertex, color)),
+    ]
+};
+
+/// What the bake's stages and the host agree on: the textures and the material table at set 0,
+/// the draw's constants, and the vertex layout.
+pub const INTERFACES: [Interface; 3] = {
+    const SETS: &[&[BindingKind]] = &[&graphics::set_layout(SLOTS as u32)];
+    const STRUCTS: &[GlslStruct] = &[GpuMaterial::GLSL, GpuTextureSlot::GLSL];
+    const fn stage(stage: &Stage, vertex_inputs: &'static [Attribute]) -> Interface {
+        Interface {
+            file: stage.file,
+            spirv: stage.spirv,
+            sets: SETS,
+            push: Some(DrawConstants::GLSL),
+            structs: STRUCTS,
+            vertex_inputs,
+        }
+    }
+    [
+        stage(&shaders::BAKE_VERTEX, &VERTEX_ATTRIBUTES),
+        stage(&shaders::BAKE_FRAGMENT, &[]),
+        stage(&shaders::BAKE_MAPS_FRAGMENT, &[]),
+    ]
+};
 
 /// The steps of a bake, for progress reports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -301,7 +368,8 @@ fn gpu_material(material: &gltf::Material, references: &[Option<textures::Textur
                 // Sets beyond TEXCOORD_1 are not read; they were reported, and sample set 0.
                 tex_coord: if r.tex_coord == 1 { 1 } else { 0 },
                 present: 1,
-                pad: [0; 2],
+                pad0: 0,
+                pad1: 0,
             };
         }
     }
@@ -316,7 +384,8 @@ fn gpu_material(material: &gltf::Material, references: &[Option<textures::Textur
             .and_then(|e| e.get("clearcoatRoughnessFactor"))
             .and_then(|v| v.as_f64())
             .unwrap_or(0.0) as f32,
-        pad: [0.0; 2],
+        pad0: 0.0,
+        pad1: 0.0,
         base_color_factor: factor,
         sheen_color_factor: extension_color("KHR_materials_sheen", "sheenColorFactor", [0.0; 3]),
         specular_color_factor: {
@@ -336,20 +405,6 @@ impl Rasterizer {
         kinds: &[Vec<MapKind>],
         (width, height, samples): (u32, u32, u32),
     ) -> Result<Rasterizer> {
-        let attribute = |location, format, offset| Attribute { location, format, offset };
-        let f32x = |n: usize| match n {
-            2 => vk::Format::R32G32_SFLOAT,
-            3 => vk::Format::R32G32B32_SFLOAT,
-            _ => vk::Format::R32G32B32A32_SFLOAT,
-        };
-        let attributes = [
-            attribute(0, f32x(3), 0),
-            attribute(1, f32x(3), 12),
-            attribute(2, f32x(4), 24),
-            attribute(3, f32x(2), 40),
-            attribute(4, f32x(2), 48),
-            attribute(5, f32x(4), 56),
-        ];
         let pipeline = |fragment, color_formats| {
             GraphicsPipeline::new(
                 ctx,
@@ -357,11 +412,11 @@ impl Rasterizer {
                     vertex: &shaders::BAKE_VERTEX,
                     fragment,
                     stride: std::mem::size_of::<Vertex>() as u32,
-                    attributes: &attributes,
+                    attributes: &VERTEX_ATTRIBUTES,
                     color_formats,
                     depth_format: vk::Format::D32_SFLOAT,
                     textures: SLOTS as u32,
-                    push_size: std::mem::size_of::<DrawConstants>() as u32,
+                    push_size: INTERFACES[0].push_size(),
                 },
             )
         };

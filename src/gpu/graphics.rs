@@ -4,6 +4,7 @@
 
 use super::context::{Context, Shared};
 use super::memory::{Buffer, Image};
+use super::pipeline::BindingKind;
 use super::shaders::Stage;
 use crate::{Error, Result};
 use ash::vk;
@@ -43,6 +44,12 @@ pub struct GraphicsPipeline {
     push_size: u32,
 }
 
+/// The descriptor set of every graphics pipeline: `textures` combined image samplers at binding
+/// 0, then one storage buffer.
+pub const fn set_layout(textures: u32) -> [BindingKind; 2] {
+    [BindingKind::Textures(textures), BindingKind::StorageBuffer]
+}
+
 const STAGES: vk::ShaderStageFlags =
     vk::ShaderStageFlags::from_raw(vk::ShaderStageFlags::VERTEX.as_raw() | vk::ShaderStageFlags::FRAGMENT.as_raw());
 
@@ -55,18 +62,19 @@ fn module(ctx: &Context, stage: &Stage) -> Result<vk::ShaderModule> {
 impl GraphicsPipeline {
     pub fn new(ctx: &Context, desc: &PipelineDesc) -> Result<GraphicsPipeline> {
         let device = &ctx.device;
-        let bindings = [
-            vk::DescriptorSetLayoutBinding::default()
-                .binding(0)
-                .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-                .descriptor_count(desc.textures)
-                .stage_flags(vk::ShaderStageFlags::FRAGMENT),
-            vk::DescriptorSetLayoutBinding::default()
-                .binding(1)
-                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                .descriptor_count(1)
-                .stage_flags(STAGES),
-        ];
+        let bindings: Vec<_> = set_layout(desc.textures)
+            .into_iter()
+            .enumerate()
+            .map(|(i, kind)| {
+                // Only the fragment stage samples the textures.
+                let stages = if kind == BindingKind::StorageBuffer { STAGES } else { vk::ShaderStageFlags::FRAGMENT };
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(i as u32)
+                    .descriptor_type(kind.descriptor_type())
+                    .descriptor_count(kind.count())
+                    .stage_flags(stages)
+            })
+            .collect();
         let set_layout = unsafe {
             device.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None)
         }?;

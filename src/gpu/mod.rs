@@ -4,12 +4,14 @@
 
 pub mod context;
 pub mod graphics;
+pub mod interface;
 pub mod memory;
 pub mod pipeline;
 pub mod shaders;
 pub mod timer;
 
 pub use context::{Context, ContextOptions, DeviceInfo, Presentation};
+pub use interface::{GlslLayout, GlslStruct, Interface};
 pub use memory::{Buffer, Image};
 pub use pipeline::{Binding, BindingKind, ComputePipeline, DescriptorSet};
 pub use timer::GpuTimer;

@@ -12,13 +12,24 @@ use std::sync::Arc;
 pub enum BindingKind {
     StorageImage,
     StorageBuffer,
+    /// An array of this many combined image samplers (the bake's textures).
+    Textures(u32),
 }
 
 impl BindingKind {
-    fn descriptor_type(self) -> vk::DescriptorType {
+    pub fn descriptor_type(self) -> vk::DescriptorType {
         match self {
             BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
             BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
+            BindingKind::Textures(_) => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+        }
+    }
+
+    /// Descriptors at the binding.
+    pub fn count(self) -> u32 {
+        match self {
+            BindingKind::Textures(count) => count,
+            _ => 1,
         }
     }
 }

@@ -5,12 +5,18 @@
 /// One compute kernel's SPIR-V.
 pub struct Kernel {
     pub name: &'static str,
+    /// `<name>.comp`, in `glsl/`.
+    pub file: &'static str,
     pub spirv: &'static [u8],
 }
 
 macro_rules! kernel {
     ($name:literal) => {
-        Kernel { name: $name, spirv: include_bytes!(concat!("../../spirv/", $name, ".comp.spv")) }
+        Kernel {
+            name: $name,
+            file: concat!($name, ".comp"),
+            spirv: include_bytes!(concat!("../../spirv/", $name, ".comp.spv")),
+        }
     };
 }
 

@@ -90,20 +90,22 @@ impl Param {
 
     /// Where the parameter sits in [`Params::to_gpu`]'s layout (a colour takes three places).
     pub fn gpu_index(self) -> usize {
-        match self {
-            Param::BaseColor => 0,
-            Param::Metallic => 3,
-            Param::Subsurface => 4,
-            Param::Specular => 5,
-            Param::SpecularTint => 6,
-            Param::Roughness => 7,
-            Param::Anisotropic => 8,
-            Param::Sheen => 9,
-            Param::SheenTint => 10,
-            Param::Clearcoat => 11,
-            Param::ClearcoatGloss => 12,
-            Param::Emission => 16,
-        }
+        use std::mem::offset_of;
+        let offset = match self {
+            Param::BaseColor => offset_of!(GpuParams, base_color),
+            Param::Metallic => offset_of!(GpuParams, metallic),
+            Param::Subsurface => offset_of!(GpuParams, subsurface),
+            Param::Specular => offset_of!(GpuParams, specular),
+            Param::SpecularTint => offset_of!(GpuParams, specular_tint),
+            Param::Roughness => offset_of!(GpuParams, roughness),
+            Param::Anisotropic => offset_of!(GpuParams, anisotropic),
+            Param::Sheen => offset_of!(GpuParams, sheen),
+            Param::SheenTint => offset_of!(GpuParams, sheen_tint),
+            Param::Clearcoat => offset_of!(GpuParams, clearcoat),
+            Param::ClearcoatGloss => offset_of!(GpuParams, clearcoat_gloss),
+            Param::Emission => offset_of!(GpuParams, emission),
+        };
+        offset / 4
     }
 
     /// The names of all parameters, for error messages.
@@ -183,6 +185,51 @@ pub const GPU_FLOATS: usize = 20;
 /// The BRDF's part of that layout, the first four vec4s: what `material.glsl` unpacks.
 pub const BRDF_GPU_FLOATS: usize = 16;
 
+/// [`Params`] as the GPU holds them: five vec4s, the first four as `unpack_material` in
+/// `glsl/include/material.glsl` reads them (`p0.rgb` is bytes 0–11, `p0.a` 12–15, `p1.x` 16–19,
+/// …), then emission, which `relight.comp` reads on its own.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuParams {
+    base_color: [f32; 3],
+    metallic: f32,
+    subsurface: f32,
+    specular: f32,
+    specular_tint: f32,
+    roughness: f32,
+    anisotropic: f32,
+    sheen: f32,
+    sheen_tint: f32,
+    clearcoat: f32,
+    clearcoat_gloss: f32,
+    ior_edge: [f32; 3],
+    emission: [f32; 3],
+    pad: f32,
+}
+
+crate::glsl_struct!(GpuParams as "unpack_material", 80 bytes {
+    base_color @ 0,
+    metallic @ 12,
+    subsurface @ 16,
+    specular @ 20,
+    specular_tint @ 24,
+    roughness @ 28,
+    anisotropic @ 32,
+    sheen @ 36,
+    sheen_tint @ 40,
+    clearcoat @ 44,
+    clearcoat_gloss @ 48,
+    ior_edge @ 52,
+    emission @ 64,
+    pad @ 76,
+});
+
+const _: () = assert!(std::mem::size_of::<GpuParams>() == 4 * GPU_FLOATS);
+const _: () = assert!(std::mem::offset_of!(GpuParams, emission) == 4 * BRDF_GPU_FLOATS);
+
+/// The layout `unpack_material` (and, for emission, `relight.comp`) reads, by member name.
+pub const GPU_LAYOUT: crate::gpu::GlslStruct = <GpuParams as crate::gpu::GlslLayout>::GLSL;
+
 impl Params {
     pub fn get(&self, param: Param) -> Value {
         let g = self.to_gpu();
@@ -208,35 +255,24 @@ impl Params {
         Ok(())
     }
 
-    /// The GPU layout, mirrored by `glsl/include/material.glsl`:
-    /// `[base_color.rgb, metallic] [subsurface, specular, specular_tint, roughness]
-    ///  [anisotropic, sheen, sheen_tint, clearcoat] [clearcoat_gloss, ior_edge.rgb]
-    ///  [emission.rgb, 0]`.
+    /// The GPU layout: [`GpuParams`] as floats.
     pub fn to_gpu(&self) -> [f32; GPU_FLOATS] {
-        let [r, g, b] = self.base_color;
-        let [er, eg, eb] = self.emission;
-        [
-            r,
-            g,
-            b,
-            self.metallic,
-            self.subsurface,
-            self.specular,
-            self.specular_tint,
-            self.roughness,
-            self.anisotropic,
-            self.sheen,
-            self.sheen_tint,
-            self.clearcoat,
-            self.clearcoat_gloss,
-            self.ior_edge[0],
-            self.ior_edge[1],
-            self.ior_edge[2],
-            er,
-            eg,
-            eb,
-            0.0,
-        ]
+        bytemuck::cast(GpuParams {
+            base_color: self.base_color,
+            metallic: self.metallic,
+            subsurface: self.subsurface,
+            specular: self.specular,
+            specular_tint: self.specular_tint,
+            roughness: self.roughness,
+            anisotropic: self.anisotropic,
+            sheen: self.sheen,
+            sheen_tint: self.sheen_tint,
+            clearcoat: self.clearcoat,
+            clearcoat_gloss: self.clearcoat_gloss,
+            ior_edge: self.ior_edge,
+            emission: self.emission,
+            pad: 0.0,
+        })
     }
 
     /// The BRDF's part of [`Params::to_gpu`], for kernels that evaluate only the BRDF.
@@ -247,20 +283,21 @@ impl Params {
     }
 
     pub fn from_gpu(v: &[f32; GPU_FLOATS]) -> Params {
+        let p: GpuParams = bytemuck::cast(*v);
         Params {
-            base_color: [v[0], v[1], v[2]],
-            metallic: v[3],
-            subsurface: v[4],
-            specular: v[5],
-            specular_tint: v[6],
-            roughness: v[7],
-            anisotropic: v[8],
-            sheen: v[9],
-            sheen_tint: v[10],
-            clearcoat: v[11],
-            clearcoat_gloss: v[12],
-            ior_edge: [v[13], v[14], v[15]],
-            emission: [v[16], v[17], v[18]],
+            base_color: p.base_color,
+            metallic: p.metallic,
+            subsurface: p.subsurface,
+            specular: p.specular,
+            specular_tint: p.specular_tint,
+            roughness: p.roughness,
+            anisotropic: p.anisotropic,
+            sheen: p.sheen,
+            sheen_tint: p.sheen_tint,
+            clearcoat: p.clearcoat,
+            clearcoat_gloss: p.clearcoat_gloss,
+            ior_edge: p.ior_edge,
+            emission: p.emission,
         }
     }
 

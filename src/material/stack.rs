@@ -28,6 +28,8 @@ pub struct GpuLayer {
     pub pad: u32,
 }
 
+crate::glsl_struct!(GpuLayer as "Layer", 176 bytes { params @ 0, maps @ 80, mask @ 160, invert @ 164, opacity @ 168, pad @ 172 });
+
 impl GpuLayer {
     /// A lone layer of the default parameters, for objects no stack covers.
     fn default_material() -> GpuLayer {
@@ -156,8 +158,11 @@ pub fn unused_stack_warnings(look: &Look, object_ids: &[u32], gbuffer_name: &Pat
 pub struct GpuStack {
     pub first_layer: u32,
     pub layer_count: u32,
-    pub pad: [u32; 2],
+    pub pad0: u32,
+    pub pad1: u32,
 }
+
+crate::glsl_struct!(GpuStack as "Stack", 16 bytes { first_layer @ 0, layer_count @ 4, pad0 @ 8, pad1 @ 12 });
 
 /// Every stack the g-buffer's objects need, ready to upload.
 #[derive(Clone, Debug, PartialEq)]
@@ -226,13 +231,13 @@ impl PackedStacks {
             }
             let layer_count = packed.layers.len() as u32 - first_layer;
             packed.stack_of_object.insert(id, packed.stacks.len() as u32);
-            packed.stacks.push(GpuStack { first_layer, layer_count, pad: [0; 2] });
+            packed.stacks.push(GpuStack { first_layer, layer_count, pad0: 0, pad1: 0 });
         }
         // Pixels that shade nothing still index a stack; with no shaded object at all, that is
         // a default-material stack.
         if packed.stacks.is_empty() {
             packed.layers.push(GpuLayer::default_material());
-            packed.stacks.push(GpuStack { first_layer: 0, layer_count: 1, pad: [0; 2] });
+            packed.stacks.push(GpuStack { first_layer: 0, layer_count: 1, pad0: 0, pad1: 0 });
         }
         Ok(packed)
     }

@@ -1,18 +1,21 @@
 //! Building a model's energy-compensation table on the GPU (`glsl/energy_table.comp`), once per
 //! renderer that needs one.
 
-use crate::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context};
+use crate::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, Interface};
 use crate::shading::energy::{EnergyTable, SIZE};
 use crate::shading::model::Model;
 use crate::Result;
+
+/// What `energy_table.comp` and the host agree on: the table, as one storage buffer.
+pub const INTERFACE: Interface = Interface::compute(&shaders::ENERGY_TABLE, &[&[BindingKind::StorageBuffer]], None);
 
 /// E(μ, roughness) for the model's D and G, computed on the GPU, with its averages.
 pub fn build(ctx: &Context, model: &Model) -> Result<EnergyTable> {
     let pipeline = ComputePipeline::specialized(
         ctx,
         &shaders::ENERGY_TABLE,
-        &[&[BindingKind::StorageBuffer]],
-        0,
+        INTERFACE.sets,
+        INTERFACE.push_size(),
         &model.specialization(),
     )?;
     let output = Buffer::storage(ctx, (SIZE * SIZE * 4) as u64)?;

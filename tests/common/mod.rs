@@ -7,6 +7,7 @@ pub mod display;
 pub mod gltf;
 pub mod golden;
 pub mod gpu;
+pub mod probes;
 pub mod random;
 pub mod reference;
 pub mod reference_render;

@@ -3,9 +3,12 @@
 
 use super::{groups, Targets};
 use crate::gbuffer::gpu::GpuGBuffer;
-use crate::gpu::{shaders, Binding, BindingKind, ComputePipeline, Context, DescriptorSet};
+use crate::gpu::{shaders, Binding, BindingKind, ComputePipeline, Context, DescriptorSet, GlslLayout, Interface};
 use crate::Result;
 use ash::vk;
+
+/// What `finalize.comp` and the host agree on.
+pub const INTERFACE: Interface = Interface::compute(&shaders::FINALIZE, &[&SET], Some(FinalizePush::GLSL));
 
 /// Set 0 of `finalize.comp`: accumulation, background, surface, radiance, display.
 pub const SET: [BindingKind; 5] = [BindingKind::StorageImage; 5];
@@ -24,6 +27,14 @@ pub struct FinalizePush {
     pub end_row: u32,
 }
 
+crate::glsl_struct!(FinalizePush as "Finalize", 20 bytes {
+    exposure_scale @ 0,
+    tonemap @ 4,
+    show_background @ 8,
+    first_row @ 12,
+    end_row @ 16,
+});
+
 pub struct FinalizePass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
@@ -31,8 +42,7 @@ pub struct FinalizePass {
 
 impl FinalizePass {
     pub fn new(ctx: &Context, gbuffer: &GpuGBuffer, targets: &Targets) -> Result<FinalizePass> {
-        let size = std::mem::size_of::<FinalizePush>() as u32;
-        let pipeline = ComputePipeline::new(ctx, &shaders::FINALIZE, &[&SET], size)?;
+        let pipeline = ComputePipeline::new(ctx, &shaders::FINALIZE, INTERFACE.sets, INTERFACE.push_size())?;
         let set = pipeline.bind(
             0,
             &[

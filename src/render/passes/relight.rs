@@ -5,13 +5,19 @@
 use super::{groups, Targets};
 use crate::environment::{self, GpuEnvironment};
 use crate::gbuffer::gpu::GpuGBuffer;
-use crate::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet};
+use crate::gpu::{
+    shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, GlslLayout, Interface,
+};
 use crate::shading::brdf::Shading;
 use crate::shading::energy::EnergyTable;
 use crate::shading::model::Model;
 use crate::Result;
 use ash::vk;
 use std::sync::Arc;
+
+/// What `relight.comp` and the host agree on.
+pub const INTERFACE: Interface =
+    Interface::compute(&shaders::RELIGHT, &[&SET, &environment::gpu::SET_LAYOUT], Some(RelightPush::GLSL));
 
 /// Set 0 of `relight.comp`: surface, resolved material, accumulation, background, energy
 /// table, lobe sums, squared luminances. Set 1 is the environment's.
@@ -42,6 +48,18 @@ pub struct RelightPush {
     pub first_row: u32,
     pub end_row: u32,
 }
+
+crate::glsl_struct!(RelightPush as "Pass", 36 bytes {
+    first_sample @ 0,
+    sample_count @ 4,
+    seed @ 8,
+    show_background @ 12,
+    cos_rotation @ 16,
+    sin_rotation @ 20,
+    intensity @ 24,
+    first_row @ 28,
+    end_row @ 32,
+});
 
 /// What the relight kernel accumulates beside the total, for the AOVs that need it
 /// (docs/formats.md: AOVs). What is off costs nothing: the kernel is specialised without it,
@@ -81,13 +99,8 @@ impl RelightPass {
     ) -> Result<RelightPass> {
         let mut constants = model.specialization().to_vec();
         constants.extend([accumulate.lobes as u32, accumulate.variance as u32]);
-        let pipeline = ComputePipeline::specialized(
-            ctx,
-            &shaders::RELIGHT,
-            &[&SET, &environment::gpu::SET_LAYOUT],
-            std::mem::size_of::<RelightPush>() as u32,
-            &constants,
-        )?;
+        let pipeline =
+            ComputePipeline::specialized(ctx, &shaders::RELIGHT, INTERFACE.sets, INTERFACE.push_size(), &constants)?;
         // The energy table is built on the GPU; a placeholder unless the model compensates.
         let (table, energy) = if model.energy_compensation {
             let table = crate::render::energy::build(ctx, model)?;

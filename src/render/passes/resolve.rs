@@ -4,8 +4,10 @@
 
 use super::{groups, Targets};
 use crate::gbuffer::gpu::GpuGBuffer;
-use crate::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, Image};
-use crate::material::stack::PackedStacks;
+use crate::gpu::{
+    shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, GlslLayout, Image, Interface,
+};
+use crate::material::stack::{GpuLayer, GpuStack, PackedStacks};
 use crate::Result;
 use ash::vk;
 
@@ -19,8 +21,10 @@ pub const SET: [BindingKind; 5] = [
     BindingKind::StorageImage,
 ];
 
-/// `resolve.comp` has no push constants.
-pub const PUSH_SIZE: u32 = 0;
+/// What `resolve.comp` and the host agree on: no push constants, and the stacks and layers as
+/// [`PackedStacks`] holds them.
+pub const INTERFACE: Interface =
+    Interface { structs: &[GpuStack::GLSL, GpuLayer::GLSL], ..Interface::compute(&shaders::RESOLVE, &[&SET], None) };
 
 /// The stacks on the GPU, held while the set points at them.
 struct Stacks {
@@ -37,7 +41,10 @@ pub struct ResolvePass {
 
 impl ResolvePass {
     pub fn new(ctx: &Context) -> Result<ResolvePass> {
-        Ok(ResolvePass { pipeline: ComputePipeline::new(ctx, &shaders::RESOLVE, &[&SET], PUSH_SIZE)?, stacks: None })
+        Ok(ResolvePass {
+            pipeline: ComputePipeline::new(ctx, &shaders::RESOLVE, INTERFACE.sets, INTERFACE.push_size())?,
+            stacks: None,
+        })
     }
 
     /// Uploads `packed` (and the g-buffer channels it reads) and binds it for [`Self::record`].
