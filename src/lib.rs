@@ -17,6 +17,7 @@ pub mod lab;
 pub mod material;
 pub mod render;
 pub mod shading;
+pub mod suggest;
 #[cfg(feature = "viewer")]
 pub mod viewer;
 pub mod viewer_state;

@@ -8,7 +8,7 @@ use lookdev::material::look::Look;
 use lookdev::material::params::{Param, Value};
 use lookdev::material::preset::Preset;
 use lookdev::render::settings::{Overrides, Settings};
-use lookdev::render::tonemap::Tonemap;
+use lookdev::shading::tonemap::Tonemap;
 use lookdev::viewer_state::{Document, Edit, ObjectRef, Selection};
 
 /// A default stack and a three-layer stack for object 1, the middle layer overriding roughness.

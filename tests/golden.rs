@@ -41,7 +41,7 @@ fn glossy_metal_with_agx_matches_its_golden_image() {
     let mut look = Look::builtin_default();
     look.objects.retain(|o| o.id.is_none());
     look.objects[0].layers[0].params = lookdev::material::library::builtin("chrome").unwrap().params;
-    look.render.tonemap = Some(lookdev::render::tonemap::Tonemap::Agx);
+    look.render.tonemap = Some(lookdev::shading::tonemap::Tonemap::Agx);
     look.render.exposure = Some(1.0);
     golden("shaderball_chrome_agx.png", 192, 192, &render(look, 192, 256));
 }

@@ -7,7 +7,7 @@ use lookdev::material::library::{self, Library};
 use lookdev::material::look::Look;
 use lookdev::material::params::{Param, Params, Value};
 use lookdev::material::preset::Preset;
-use lookdev::render::tonemap::Tonemap;
+use lookdev::shading::tonemap::Tonemap;
 
 /// A look that lives in a folder no test creates, so that names resolve to the built-ins.
 const SHOT: &str = "looks/shot.toml";

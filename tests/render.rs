@@ -10,8 +10,8 @@ use lookdev::environment::{Distribution, Environment};
 use lookdev::gbuffer::GBuffer;
 use lookdev::material::stack::PackedStacks;
 use lookdev::material::{Look, Params};
-use lookdev::render::tonemap::{self, Tonemap};
 use lookdev::render::Lighting;
+use lookdev::shading::tonemap::{self, Tonemap};
 use std::path::Path;
 
 fn one_material_look(params: &Params) -> Look {

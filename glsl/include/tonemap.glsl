@@ -1,4 +1,4 @@
-// Display transforms: tone maps and the sRGB OETF. Mirrored in src/render/tonemap.rs.
+// Display transforms: tone maps and the sRGB OETF. Mirrored in src/shading/tonemap.rs.
 #ifndef LOOKDEV_TONEMAP_GLSL
 #define LOOKDEV_TONEMAP_GLSL
 

@@ -7,7 +7,7 @@ use crate::gbuffer::source::{Channels, SourceOptions, Up};
 use crate::material::{Look, Param, Value};
 use crate::render::scene::{GBufferSpec, LookSource, SceneSpec};
 use crate::render::settings::Overrides;
-use crate::render::tonemap::Tonemap;
+use crate::shading::tonemap::Tonemap;
 use crate::{Error, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};

@@ -154,7 +154,7 @@ fn write_aov_png(
     for p in 0..pixels {
         let value = glam::Vec3::new(channel(0)[p], channel(1)[p], channel(2)[p]);
         let rgb = match aov {
-            a if a.is_radiance() => crate::render::tonemap::display_pixel(value, settings.exposure, settings.tonemap),
+            a if a.is_radiance() => crate::shading::tonemap::display_pixel(value, settings.exposure, settings.tonemap),
             Aov::Normal | Aov::View => encode(value * 0.5 + 0.5),
             Aov::ObjectId => id_colour(value.x as u32),
             Aov::Variance => encode(glam::Vec3::splat(value.x.sqrt())),
@@ -167,7 +167,7 @@ fn write_aov_png(
 
 /// A value in [0, 1] as sRGB bytes.
 fn encode(v: glam::Vec3) -> [u8; 3] {
-    v.to_array().map(|c| (crate::render::tonemap::srgb_encode(c.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8)
+    v.to_array().map(|c| (crate::shading::tonemap::srgb_encode(c.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8)
 }
 
 /// A distinct colour per object id (0, the background, black).

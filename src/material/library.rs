@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use super::preset::Preset;
-use super::toml_input::closest;
+use crate::suggest::closest;
 
 /// The user's preset library: `$LOOKDEV_PRESETS` if set, else `$XDG_DATA_HOME/lookdev/presets`,
 /// else `~/.local/share/lookdev/presets`. None only without any of those variables.

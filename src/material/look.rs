@@ -51,9 +51,8 @@ use super::library::Library;
 use super::params::{Param, Params, Value};
 use super::toml_input::{self as input, Field, Source};
 use crate::gbuffer::source::{Channels, SourceOptions, Up};
-use crate::render::settings::MAX_EXPOSURE;
-use crate::render::tonemap::Tonemap;
 use crate::shading::model::{Model, ModelValue};
+use crate::shading::tonemap::{Tonemap, MAX_EXPOSURE};
 
 /// What to render: environment, render settings and the layer stacks.
 #[derive(Clone, Debug, PartialEq)]
@@ -735,7 +734,7 @@ fn layer(src: &Source, raw: &Field<LayerFile>, library: &Library) -> crate::Resu
 
 fn unknown_param(name: &str, table: &str) -> String {
     let names = Param::ALL.map(Param::name);
-    input::unknown("parameter", name, &format!("in {table}"), &names)
+    crate::suggest::unknown("parameter", name, &format!("in {table}"), &names)
 }
 
 /// A map's name as a binding gives it: `name` or `name.R|G|B`, without the `map.` prefix.

@@ -7,8 +7,6 @@ pub mod preset;
 pub mod stack;
 mod toml_input;
 
-pub(crate) use toml_input::{near_miss, unknown as unknown_key};
-
 pub use look::Look;
 pub use params::{Param, Params, Value};
 pub use preset::Preset;

@@ -227,6 +227,13 @@ crate::glsl_struct!(GpuParams as "unpack_material", 80 bytes {
 const _: () = assert!(std::mem::size_of::<GpuParams>() == 4 * GPU_FLOATS);
 const _: () = assert!(std::mem::offset_of!(GpuParams, emission) == 4 * BRDF_GPU_FLOATS);
 
+/// The BRDF's view of the parameters, unpacked from the GPU layout as the kernels unpack it.
+impl From<&Params> for crate::shading::material::Material {
+    fn from(params: &Params) -> Self {
+        crate::shading::material::unpack_material(&params.brdf_gpu())
+    }
+}
+
 /// The layout `unpack_material` (and, for emission, `relight.comp`) reads, by member name.
 pub const GPU_LAYOUT: crate::gpu::GlslStruct = <GpuParams as crate::gpu::GlslLayout>::GLSL;
 

@@ -99,7 +99,7 @@ fn bound_channels(
         None => {
             let names: Vec<String> = gbuffer.maps().into_iter().map(|m| m.name).collect();
             let candidates: Vec<&str> = names.iter().map(String::as_str).collect();
-            let hint = super::near_miss(map, &candidates).map(|n| format!("; did you mean '{n}'?")).unwrap_or_default();
+            let hint = crate::suggest::near_miss(map, &candidates).map(|n| format!("; did you mean '{n}'?")).unwrap_or_default();
             Err(format!("map '{map}' (bound to {param}) is not in the g-buffer {file} (it has {}){hint}", gbuffer.map_list()))
         }
     }

@@ -95,7 +95,7 @@ impl Aov {
         let mut names: Vec<String> = all.iter().map(|a| a.name()).collect();
         names.extend(GROUPS.iter().map(|(g, _)| g.to_string()));
         let names: Vec<&str> = names.iter().map(String::as_str).collect();
-        Err(crate::material::unknown_key("AOV", name, "", &names))
+        Err(crate::suggest::unknown("AOV", name, "", &names))
     }
 
     /// Parses a list of names (from `--aov` or a look's `[render] aovs`), in the order of

@@ -2,7 +2,8 @@
 //! renderer that needs one.
 
 use crate::gpu::{shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, Interface};
-use crate::shading::energy::{EnergyTable, SIZE};
+use crate::shading::brdf::{EnergyTable, ENERGY_TABLE_SIZE as SIZE};
+use crate::shading::energy::table_from_albedo;
 use crate::shading::model::Model;
 use crate::Result;
 
@@ -25,5 +26,5 @@ pub fn build(ctx: &Context, model: &Model) -> Result<EnergyTable> {
         Ok(())
     })?;
     let albedo: Vec<f32> = bytemuck::cast_slice(&output.read(ctx)?[..SIZE * SIZE * 4]).to_vec();
-    Ok(EnergyTable::from_albedo(albedo))
+    Ok(table_from_albedo(albedo))
 }

@@ -11,6 +11,5 @@ pub mod renderer;
 pub mod scene;
 pub mod settings;
 pub mod sheet;
-pub mod tonemap;
 
 pub use renderer::{Lighting, Renderer};

@@ -10,9 +10,9 @@ use crate::gbuffer::gpu::GpuGBuffer;
 use crate::gbuffer::GBuffer;
 use crate::gpu::{Buffer, Context, GpuTimer, Image};
 use crate::material::stack::PackedStacks;
-use crate::render::tonemap::Tonemap;
 use crate::shading::brdf::Shading;
 use crate::shading::model::Model;
+use crate::shading::tonemap::Tonemap;
 use crate::Result;
 use ash::vk;
 

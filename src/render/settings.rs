@@ -1,16 +1,14 @@
 //! Render settings: the look's values, overridden by command-line flags, over the defaults.
 
-use super::tonemap::Tonemap;
 use super::Lighting;
 use crate::material::Look;
 use crate::shading::model::Model;
+use crate::shading::tonemap::{Tonemap, MAX_EXPOSURE};
 use crate::{Error, Result};
 use std::path::PathBuf;
 
 /// Samples per pixel when neither the look nor a flag says.
 pub const DEFAULT_SPP: u32 = 256;
-/// Exposures beyond this many stops overflow (or underflow) float radiance to inf (or 0).
-pub const MAX_EXPOSURE: f32 = 64.0;
 
 /// Values given on the command line; `None` leaves the look's value.
 #[derive(Clone, Debug, Default)]

@@ -6,9 +6,8 @@
 //! table, from [`make_lobes_with`].
 
 use super::common::{mix, INV_PI, PI};
-use super::energy::{self, EnergyTable};
+use super::material::Material;
 use super::model::{Diffuse, Fresnel, Model, SpecularD, SpecularG};
-use crate::material::Params;
 use glam::Vec3;
 use std::sync::Arc;
 
@@ -146,14 +145,44 @@ pub fn normal_reflectance(n: f64, k: f64) -> f64 {
     ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k)
 }
 
-/// Directional albedo of the specular lobe from the energy table (GLSL `energy_albedo`).
-pub fn energy_albedo(table: &EnergyTable, mu: f32, roughness: f32) -> f32 {
-    energy::lookup(&table.values, mu, roughness)
+/// Nodes per axis of the energy table: √μ and roughness, each from 0 to 1 (GLSL
+/// `ENERGY_TABLE_SIZE`).
+pub const ENERGY_TABLE_SIZE: usize = 32;
+
+/// The energy-compensation table of a model (Kulla and Conty 2017), the layout of the
+/// `energy_table` buffer: the directional albedo E(μ, roughness) of the single-scattering
+/// specular lobe with F = 1 on the grid (μ fastest), then its average E_avg per roughness node.
+/// [`super::energy`] builds it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EnergyTable {
+    pub values: Vec<f32>,
+}
+
+impl EnergyTable {
+    /// A table of zeros, bound where compensation is off (the shaders never read it then).
+    pub fn placeholder() -> EnergyTable {
+        EnergyTable { values: vec![0.0; ENERGY_TABLE_SIZE * ENERGY_TABLE_SIZE + ENERGY_TABLE_SIZE] }
+    }
+}
+
+/// Directional albedo of the specular lobe, bilinear in (√μ, roughness) (GLSL `energy_albedo`).
+/// Reads only the E part of `values`, so the builder can average a table still without E_avg.
+pub fn energy_albedo(values: &[f32], mu: f32, roughness: f32) -> f32 {
+    let n = ENERGY_TABLE_SIZE as i32;
+    let x = mu.clamp(0.0, 1.0).sqrt() * (n - 1) as f32;
+    let y = roughness.clamp(0.0, 1.0) * (n - 1) as f32;
+    let x0 = (x as i32).min(n - 2);
+    let y0 = (y as i32).min(n - 2);
+    let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+    let i = (y0 * n + x0) as usize;
+    let bottom = mix(values[i], values[i + 1], fx);
+    let top = mix(values[i + ENERGY_TABLE_SIZE], values[i + ENERGY_TABLE_SIZE + 1], fx);
+    mix(bottom, top, fy)
 }
 
 /// E_avg(roughness) from the energy table (GLSL `energy_average`).
 pub fn energy_average(table: &EnergyTable, roughness: f32) -> f32 {
-    let n = energy::SIZE as i32;
+    let n = ENERGY_TABLE_SIZE as i32;
     let y = roughness.clamp(0.0, 1.0) * (n - 1) as f32;
     let y0 = (y as i32).min(n - 2);
     let i = (n * n + y0) as usize;
@@ -169,13 +198,15 @@ pub fn add_energy_compensation(s: &mut Lobes, table: &EnergyTable) {
 }
 
 /// [`make_lobes_with`] for the default (Disney 2012) model.
-pub fn make_lobes(m: &Params) -> Lobes {
+pub fn make_lobes(m: impl Into<Material>) -> Lobes {
     make_lobes_with(m, &Shading::default())
 }
 
-pub fn make_lobes_with(m: &Params, shading: &Shading) -> Lobes {
+/// GLSL `make_lobes`, for a model and its table.
+pub fn make_lobes_with(m: impl Into<Material>, shading: &Shading) -> Lobes {
+    let m: Material = m.into();
     let model = shading.model;
-    let base_color = Vec3::from(m.base_color);
+    let base_color = m.base_color;
     let lum = tint_luminance(base_color);
     let ctint = if lum > 0.0 { base_color / lum } else { Vec3::ONE };
     let cspec0 = (m.specular * 0.08 * Vec3::ONE.lerp(ctint, m.specular_tint)).lerp(base_color, m.metallic);
@@ -205,7 +236,7 @@ pub fn make_lobes_with(m: &Params, shading: &Shading) -> Lobes {
     let cc_alpha2 = (a * a).min(1.0);
     let (mut ior_n, mut ior_k) = (Vec3::ONE, Vec3::ZERO);
     if model.fresnel != Fresnel::Schlick {
-        let edge = if model.fresnel == Fresnel::Conductor { Vec3::from(m.ior_edge) } else { Vec3::ZERO };
+        let edge = if model.fresnel == Fresnel::Conductor { m.ior_edge } else { Vec3::ZERO };
         for c in 0..3 {
             let (n, k) = complex_ior(cspec0[c], edge[c]);
             ior_n[c] = n;
@@ -377,7 +408,7 @@ pub fn make_view(s: &Lobes, v: Vec3) -> View {
         },
         g_coat: smith_g_clearcoat(v.z),
         ms_v: match (&s.energy, model.energy_compensation) {
-            (Some(table), true) => 1.0 - energy_albedo(table, v.z, s.roughness),
+            (Some(table), true) => 1.0 - energy_albedo(&table.values, v.z, s.roughness),
             _ => 0.0,
         },
         model,
@@ -573,7 +604,7 @@ pub fn disney_lobes(s: &Lobes, view: &View, l: Vec3, hv: &HalfVector) -> BrdfLob
     let gs = specular_shadowing(s, view, l);
     b.specular = (gs * hv.d_spec) * fs;
     if let (Some(table), true) = (&s.energy, s.model.energy_compensation) {
-        b.specular += s.ms_scale * ((1.0 - energy_albedo(table, cl, s.roughness)) * view.ms_v);
+        b.specular += s.ms_scale * ((1.0 - energy_albedo(&table.values, cl, s.roughness)) * view.ms_v);
     }
 
     // Clearcoat: GTR1 with a fixed IOR 1.5.
@@ -594,12 +625,12 @@ pub fn disney_brdf(s: &Lobes, view: &View, l: Vec3, hv: &HalfVector) -> Vec3 {
 }
 
 /// f(l, v) for a material, from scratch: what the per-pixel and per-pair steps compute together.
-pub fn evaluate(params: &Params, l: Vec3, v: Vec3) -> Vec3 {
+pub fn evaluate(params: impl Into<Material>, l: Vec3, v: Vec3) -> Vec3 {
     evaluate_with(params, &Shading::default(), l, v)
 }
 
 /// [`evaluate`] for a model.
-pub fn evaluate_with(params: &Params, shading: &Shading, l: Vec3, v: Vec3) -> Vec3 {
+pub fn evaluate_with(params: impl Into<Material>, shading: &Shading, l: Vec3, v: Vec3) -> Vec3 {
     let s = make_lobes_with(params, shading);
     disney_brdf(&s, &make_view(&s, v), l, &make_half_vector(&s, l, v))
 }

@@ -166,7 +166,7 @@ fn choose<T: Copy>(key: &str, value: &str, all: &[T], name: fn(T) -> &'static st
     all.iter().copied().find(|v| name(*v) == value).ok_or_else(|| {
         let names: Vec<&str> = all.iter().map(|v| name(*v)).collect();
         let mut message = format!("{key} = '{value}' is not a model (expected {})", names.join(", "));
-        if let Some(near) = crate::material::near_miss(value, &names) {
+        if let Some(near) = crate::suggest::near_miss(value, &names) {
             message.push_str(&format!("; did you mean '{near}'?"));
         }
         message
@@ -211,7 +211,7 @@ impl Model {
                     _ => return Err("energy_compensation takes true or false".to_string()),
                 }
             }
-            _ => return Err(crate::material::unknown_key("model key", key, "in [model]", &KEYS)),
+            _ => return Err(crate::suggest::unknown("model key", key, "in [model]", &KEYS)),
         }
         Ok(())
     }

@@ -2,8 +2,8 @@
 //! measured speed so the frame stays responsive; a pass is done when the bands have swept the
 //! image. On a fast device a band is the whole image, so a change shows within one frame.
 
-use crate::render::tonemap::Tonemap;
 use crate::render::Renderer;
+use crate::shading::tonemap::Tonemap;
 use crate::Result;
 use std::time::{Duration, Instant};
 

@@ -4,7 +4,7 @@
 
 use super::action::{Action, Answer, Compare};
 use crate::material::params::{parse_value, Param, Value};
-use crate::render::tonemap::Tonemap;
+use crate::shading::tonemap::Tonemap;
 use crate::viewer_state::{Edit, ObjectRef, Selection};
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};

@@ -6,10 +6,10 @@ use std::path::PathBuf;
 
 use crate::material::look::{EnvironmentSettings, Layer, Look, ObjectStack, RenderSettings};
 use crate::material::params::{Param, Params, Value};
-use crate::render::settings::{Settings, DEFAULT_SPP, MAX_EXPOSURE};
-use crate::render::tonemap::Tonemap;
+use crate::render::settings::{Settings, DEFAULT_SPP};
 use crate::render::Lighting;
 use crate::shading::model::Model;
+use crate::shading::tonemap::{Tonemap, MAX_EXPOSURE};
 
 /// Which layer stack an edit is aimed at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]

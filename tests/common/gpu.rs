@@ -32,7 +32,7 @@ pub fn model_shading(
     ctx: &Context,
     model: &lookdev::shading::model::Model,
 ) -> (lookdev::gpu::Buffer, lookdev::shading::brdf::Shading) {
-    use lookdev::shading::energy::EnergyTable;
+    use lookdev::shading::brdf::EnergyTable;
     let table = if model.energy_compensation {
         lookdev::render::energy::build(ctx, model).unwrap()
     } else {

@@ -99,7 +99,7 @@ impl Channels {
                 self.masks.push(name.to_string());
                 return Ok(());
             }
-            other => return Err(crate::material::unknown_key("g-buffer role", other, "", &Channels::ROLES)),
+            other => return Err(crate::suggest::unknown("g-buffer role", other, "", &Channels::ROLES)),
         };
         *slot = Some(name.to_string());
         Ok(())

@@ -19,7 +19,7 @@ pub const SET: [BindingKind; 5] = [BindingKind::StorageImage; 5];
 pub struct FinalizePush {
     /// 2^EV.
     pub exposure_scale: f32,
-    /// [`crate::render::tonemap::Tonemap::gpu_id`].
+    /// [`crate::shading::tonemap::Tonemap::gpu_id`].
     pub tonemap: u32,
     pub show_background: u32,
     /// The band this dispatch covers: rows `first_row..end_row`.

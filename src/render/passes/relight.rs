@@ -8,8 +8,8 @@ use crate::gbuffer::gpu::GpuGBuffer;
 use crate::gpu::{
     shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, GlslLayout, Interface,
 };
+use crate::shading::brdf::EnergyTable;
 use crate::shading::brdf::Shading;
-use crate::shading::energy::EnergyTable;
 use crate::shading::model::Model;
 use crate::Result;
 use ash::vk;

@@ -5,7 +5,7 @@ use super::super::action::Action;
 use super::super::session::Session;
 use super::dialogs::{FileDialog, FilePurpose};
 use super::viewport::wrap_degrees;
-use crate::render::tonemap::Tonemap;
+use crate::shading::tonemap::Tonemap;
 use crate::viewer_state::Edit;
 
 pub fn show(ui: &mut egui::Ui, session: &Session, file_dialog: &mut Option<FileDialog>, actions: &mut Vec<Action>) {

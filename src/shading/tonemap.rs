@@ -5,6 +5,9 @@
 use glam::{Mat3, Vec3};
 use std::fmt;
 
+/// Exposures beyond this many stops overflow (or underflow) float radiance to inf (or 0).
+pub const MAX_EXPOSURE: f32 = 64.0;
+
 /// The tone map applied to PNG output, after exposure and before sRGB encoding.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Tonemap {
@@ -38,7 +41,7 @@ impl Tonemap {
     /// The tone map of this name, or a message that lists the names and suggests the closest.
     pub fn parse(name: &str) -> Result<Tonemap, String> {
         Tonemap::from_name(name)
-            .ok_or_else(|| crate::material::unknown_key("tone map", name, "", &Tonemap::ALL.map(Tonemap::name)))
+            .ok_or_else(|| crate::suggest::unknown("tone map", name, "", &Tonemap::ALL.map(Tonemap::name)))
     }
 
     /// The id the display kernel switches on.
