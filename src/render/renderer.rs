@@ -501,7 +501,7 @@ impl Renderer {
         let rows = rows.min(self.height.saturating_sub(first_row));
         let groups = [group_count(self.width, LOCAL_SIZE_X), group_count(rows, LOCAL_SIZE_Y), 1];
         self.finalize.dispatch(cmd, &[&self.finalize_set], bytemuck::bytes_of(&push), groups);
-        crate::gpu::context::full_barrier(&self.ctx.device, cmd);
+        crate::gpu::context::full_barrier(&self.ctx.shared.device, cmd);
     }
 
     /// Makes the display pixels (and linear radiance) of rows `first_row..first_row + rows` from
