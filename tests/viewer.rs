@@ -547,6 +547,23 @@ fn script_and_display_problems_are_clear_errors() {
     assert!(text.contains("mesa-vulkan-drivers") && !text.contains("panicked"), "{text}");
 }
 
+/// A start that fails part-way (`LOOKDEV_FAIL_AT` injects the failure) releases what it made:
+/// with validation on, an object left alive is reported when its device or instance is destroyed.
+#[test]
+fn a_viewer_that_fails_while_starting_releases_what_it_made() {
+    let Some(case) = Case::new() else { return };
+    // Before the surface; after it (with and without a device); after the presenter's command
+    // pool, command buffer and semaphore; after its swapchain.
+    for step in ["surface", "device", "context-ready", "presenter-fence", "swapchain-view"] {
+        let args = ["view", "--gbuffer", "g.exr", "--window-size", WINDOW[0], WINDOW[1]];
+        let output = case.command(&args).env("LOOKDEV_FAIL_AT", step).output().unwrap();
+        let text = stderr(&output);
+        assert_eq!(output.status.code(), Some(1), "{step}: {text}");
+        assert!(text.contains(&format!("injected failure at {step}")), "{step}: {text}");
+        assert!(!text.contains("validation error") && !text.contains("panicked"), "{step}: {text}");
+    }
+}
+
 #[test]
 fn preset_thumbnails_render_once_and_are_kept_on_disk() {
     let ctx = common::gpu::context();

@@ -525,7 +525,7 @@ impl Rasterizer {
         let nudge =
             Mat4::from_translation(Vec3::new(-2.0 * offset.0 / width as f32, -2.0 * offset.1 / height as f32, 0.0));
         let view_projection = nudge * camera.view_projection;
-        let device = &self.ctx.device;
+        let device = &self.ctx.shared.device;
         let toward_eye = -camera.forward;
         let (geometry_targets, map_targets) = self.targets.split_at(GEOMETRY_TARGETS.len());
         self.ctx.run(|cmd| {

@@ -1,5 +1,6 @@
 //! The Vulkan context: instance, the chosen device, one compute queue and its command pool.
 
+use super::inject::{self, Step};
 use crate::{Error, Result};
 use ash::vk;
 use std::ffi::{c_void, CStr, CString};
@@ -46,8 +47,30 @@ pub struct DeviceInfo {
 pub struct Presentation<'a> {
     /// Instance extensions the window system's surface needs.
     pub instance_extensions: &'a [*const std::ffi::c_char],
-    /// Makes the window's surface once the instance exists.
+    /// Makes the window's surface once the instance exists; [`Surface`] then owns it.
     pub create_surface: &'a dyn Fn(&ash::Entry, &ash::Instance) -> Result<vk::SurfaceKHR>,
+}
+
+/// A window's Vulkan surface, destroyed when dropped. It holds on to its instance, so it may
+/// outlive the context; the swapchain made on it must be destroyed first.
+pub struct Surface {
+    /// Keeps the instance until the surface is destroyed.
+    _instance: Arc<Instance>,
+    pub(crate) loader: ash::khr::surface::Instance,
+    pub(crate) handle: vk::SurfaceKHR,
+}
+
+impl Surface {
+    fn new(instance: &Arc<Instance>, handle: vk::SurfaceKHR) -> Surface {
+        let loader = ash::khr::surface::Instance::new(&instance.entry, instance);
+        Surface { _instance: instance.clone(), loader, handle }
+    }
+}
+
+impl Drop for Surface {
+    fn drop(&mut self) {
+        unsafe { self.loader.destroy_surface(self.handle, None) };
+    }
 }
 
 /// The validation message counter, shared with the debug callback.
@@ -62,36 +85,60 @@ impl ValidationCounter {
     }
 }
 
-/// Everything that must outlive every buffer, image and pipeline; they hold an `Arc` to it, so the
-/// device is destroyed only after the last of them.
-pub struct Shared {
-    pub entry: ash::Entry,
-    pub instance: ash::Instance,
+/// The Vulkan instance and, with validation on, the debug messenger that counts the layer's
+/// errors. Destroyed when its last owner (the context's [`Shared`], a [`Surface`]) drops.
+pub(crate) struct Instance {
+    pub(crate) entry: ash::Entry,
+    instance: ash::Instance,
+    /// None until made, and without validation.
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
-    pub physical_device: vk::PhysicalDevice,
-    pub device: ash::Device,
-    pub queue: vk::Queue,
-    pub queue_family: u32,
-    pub memory_properties: vk::PhysicalDeviceMemoryProperties,
-    pub info: DeviceInfo,
-    command_pool: vk::CommandPool,
-    /// Serialises [`Context::run`]: the command pool and the queue must not be used from two
-    /// threads at once.
-    submission: std::sync::Mutex<()>,
-    /// Kept alive for as long as the debug messenger that points at it.
+    /// The messengers point at it, so it lives as long as the instance.
     _counter: Arc<ValidationCounter>,
 }
 
-impl Drop for Shared {
+impl std::ops::Deref for Instance {
+    type Target = ash::Instance;
+    fn deref(&self) -> &ash::Instance {
+        &self.instance
+    }
+}
+
+impl Drop for Instance {
     fn drop(&mut self) {
         unsafe {
-            let _ = self.device.device_wait_idle();
-            self.device.destroy_command_pool(self.command_pool, None);
-            self.device.destroy_device(None);
             if let Some((loader, messenger)) = self.debug.take() {
                 loader.destroy_debug_utils_messenger(messenger, None);
             }
             self.instance.destroy_instance(None);
+        }
+        inject::count_instance(-1);
+    }
+}
+
+/// Everything that must outlive every buffer, image and pipeline; they hold an `Arc` to it, so the
+/// device is destroyed only after the last of them (and the instance after the device).
+pub(crate) struct Shared {
+    pub(crate) instance: Arc<Instance>,
+    pub(crate) physical_device: vk::PhysicalDevice,
+    pub(crate) device: ash::Device,
+    pub(crate) queue: vk::Queue,
+    pub(crate) queue_family: u32,
+    pub(crate) memory_properties: vk::PhysicalDeviceMemoryProperties,
+    pub(crate) info: DeviceInfo,
+    /// Null until made.
+    command_pool: vk::CommandPool,
+    /// Serialises [`Context::run`]: the command pool and the queue must not be used from two
+    /// threads at once.
+    submission: std::sync::Mutex<()>,
+}
+
+impl Drop for Shared {
+    fn drop(&mut self) {
+        // Destroying a null handle does nothing, so a half-made context drops cleanly.
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            self.device.destroy_command_pool(self.command_pool, None);
+            self.device.destroy_device(None);
         }
     }
 }
@@ -99,15 +146,8 @@ impl Drop for Shared {
 /// The one Vulkan context of a process: instance, device, queue and memory allocation.
 #[derive(Clone)]
 pub struct Context {
-    pub shared: Arc<Shared>,
+    pub(crate) shared: Arc<Shared>,
     counter: Arc<ValidationCounter>,
-}
-
-impl std::ops::Deref for Context {
-    type Target = Shared;
-    fn deref(&self) -> &Shared {
-        &self.shared
-    }
 }
 
 unsafe extern "system" fn debug_callback(
@@ -152,32 +192,30 @@ impl Context {
 
     /// A context that can also present to a window: the instance has the surface's extensions,
     /// the device has the swapchain extension and dynamic rendering, and its queue can present
-    /// to the surface, which is returned for the caller to own (and destroy before the context).
-    pub fn with_surface(options: &ContextOptions, presentation: Presentation) -> Result<(Context, vk::SurfaceKHR)> {
+    /// to the surface, which is returned for the caller to own.
+    pub fn with_surface(options: &ContextOptions, presentation: Presentation) -> Result<(Context, Surface)> {
         let (ctx, surface) = Context::create(options, Some(presentation))?;
         Ok((ctx, surface.expect("a surface was asked for")))
     }
 
-    fn create(
-        options: &ContextOptions,
-        presentation: Option<Presentation>,
-    ) -> Result<(Context, Option<vk::SurfaceKHR>)> {
+    /// Each part is owned as soon as it is made (the instance, the surface, then the device in
+    /// [`Shared`]), so a step that fails drops, and so destroys, the parts made before it.
+    fn create(options: &ContextOptions, presentation: Option<Presentation>) -> Result<(Context, Option<Surface>)> {
         let entry = unsafe { ash::Entry::load() }
             .map_err(|e| Error::gpu(format!("no Vulkan loader found ({e}); {INSTALL_DRIVER}")))?;
         let counter = Arc::new(ValidationCounter::default());
+        inject::watch(&counter);
         let extra = presentation.as_ref().map(|p| p.instance_extensions).unwrap_or_default();
-        let (instance, debug) = create_instance(&entry, options.validation, extra, &counter)?;
+        let instance = Arc::new(create_instance(&entry, options.validation, extra, &counter)?);
         let surface = match &presentation {
-            Some(p) => match (p.create_surface)(&entry, &instance) {
-                Ok(surface) => Some(surface),
-                Err(e) => {
-                    destroy_instance(&instance, &debug);
-                    return Err(e);
-                }
-            },
+            Some(p) => {
+                inject::check(Step::Surface)?;
+                Some(Surface::new(&instance, (p.create_surface)(&entry, &instance)?))
+            }
             None => None,
         };
-        let shared = pick_and_create_device(entry, instance, debug, options, surface, counter.clone())?;
+        let shared = create_device(instance, options, surface.as_ref())?;
+        inject::check(Step::ContextReady)?;
         Ok((Context { shared: Arc::new(shared), counter }, surface))
     }
 
@@ -194,7 +232,7 @@ impl Context {
 
     /// Holds the queue for a submission made outside [`Context::run`] (the viewer's frames).
     pub fn lock_queue(&self) -> std::sync::MutexGuard<'_, ()> {
-        self.submission.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+        self.shared.submission.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 
     pub fn info(&self) -> &DeviceInfo {
@@ -205,33 +243,51 @@ impl Context {
     /// makes the submission see everything earlier ones wrote; one after makes its writes
     /// visible to the host, for read-backs.
     pub fn run<T>(&self, record: impl FnOnce(vk::CommandBuffer) -> Result<T>) -> Result<T> {
-        let device = &self.device;
+        let shared = &*self.shared;
+        let device = &shared.device;
         let _serialised = self.lock_queue();
+        // From here on, Drop releases whatever has been created if a later step fails.
+        let mut submission = Submission { shared, cmd: vk::CommandBuffer::null(), fence: vk::Fence::null() };
         unsafe {
             let alloc = vk::CommandBufferAllocateInfo::default()
-                .command_pool(self.command_pool)
+                .command_pool(shared.command_pool)
                 .level(vk::CommandBufferLevel::PRIMARY)
                 .command_buffer_count(1);
-            let cmd = device.allocate_command_buffers(&alloc)?[0];
-            let fence = device.create_fence(&vk::FenceCreateInfo::default(), None)?;
-            let result = (|| {
-                device.begin_command_buffer(
-                    cmd,
-                    &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-                )?;
-                full_barrier(device, cmd);
-                let value = record(cmd)?;
-                host_barrier(device, cmd);
-                device.end_command_buffer(cmd)?;
-                let cmds = [cmd];
-                let submit = vk::SubmitInfo::default().command_buffers(&cmds);
-                device.queue_submit(self.queue, &[submit], fence)?;
-                device.wait_for_fences(&[fence], true, u64::MAX)?;
-                Ok(value)
-            })();
-            device.destroy_fence(fence, None);
-            device.free_command_buffers(self.command_pool, &[cmd]);
-            result
+            submission.cmd = device.allocate_command_buffers(&alloc)?[0];
+            submission.fence = device.create_fence(&vk::FenceCreateInfo::default(), None)?;
+            let (cmd, fence) = (submission.cmd, submission.fence);
+            device.begin_command_buffer(
+                cmd,
+                &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+            )?;
+            full_barrier(device, cmd);
+            let value = record(cmd)?;
+            host_barrier(device, cmd);
+            device.end_command_buffer(cmd)?;
+            let cmds = [cmd];
+            let submit = vk::SubmitInfo::default().command_buffers(&cmds);
+            device.queue_submit(shared.queue, &[submit], fence)?;
+            device.wait_for_fences(&[fence], true, u64::MAX)?;
+            Ok(value)
+        }
+    }
+}
+
+/// The command buffer and fence of one [`Context::run`], released however it ends.
+struct Submission<'a> {
+    shared: &'a Shared,
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+}
+
+impl Drop for Submission<'_> {
+    fn drop(&mut self) {
+        let device = &self.shared.device;
+        unsafe {
+            device.destroy_fence(self.fence, None);
+            if self.cmd != vk::CommandBuffer::null() {
+                device.free_command_buffers(self.shared.command_pool, &[self.cmd]);
+            }
         }
     }
 }
@@ -272,14 +328,12 @@ pub fn host_barrier(device: &ash::Device, cmd: vk::CommandBuffer) {
     }
 }
 
-type DebugMessenger = Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>;
-
 fn create_instance(
     entry: &ash::Entry,
     validation: bool,
     extra_extensions: &[*const std::ffi::c_char],
     counter: &Arc<ValidationCounter>,
-) -> Result<(ash::Instance, DebugMessenger)> {
+) -> Result<Instance> {
     let app_name = CString::new("lookdev").expect("no interior NUL");
     let app_info = vk::ApplicationInfo::default()
         .application_name(&app_name)
@@ -303,73 +357,56 @@ fn create_instance(
     }
     let enabled_features = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
     let mut validation_features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_features);
+    let mut instance_messenger = messenger_info(counter);
     let mut create_info = vk::InstanceCreateInfo::default()
         .application_info(&app_info)
         .enabled_layer_names(&layers)
         .enabled_extension_names(&extensions);
     if validation {
-        create_info = create_info.push_next(&mut validation_features);
+        // The messenger chained here also hears vkDestroyInstance, where the layer reports objects
+        // left alive (a device, a surface), after the instance's own messenger is gone.
+        create_info = create_info.push_next(&mut validation_features).push_next(&mut instance_messenger);
     }
     let instance = unsafe { entry.create_instance(&create_info, None) }.map_err(|e| match e {
         vk::Result::ERROR_INCOMPATIBLE_DRIVER => Error::gpu(format!("no Vulkan 1.3 driver found; {INSTALL_DRIVER}")),
         other => Error::gpu(format!("cannot create a Vulkan instance ({other}); {INSTALL_DRIVER}")),
     })?;
-
+    inject::count_instance(1);
+    // From here on, Drop releases whatever has been created if a later step fails.
+    let mut instance = Instance { entry: entry.clone(), instance, debug: None, _counter: counter.clone() };
     if !validation {
-        return Ok((instance, None));
+        return Ok(instance);
     }
+    inject::check(Step::DebugMessenger)?;
     let loader = ash::ext::debug_utils::Instance::new(entry, &instance);
-    let messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+    let messenger = unsafe { loader.create_debug_utils_messenger(&messenger_info(counter), None) }?;
+    instance.debug = Some((loader, messenger));
+    Ok(instance)
+}
+
+/// Errors and warnings from the validation layer, counted in `counter`.
+fn messenger_info(counter: &Arc<ValidationCounter>) -> vk::DebugUtilsMessengerCreateInfoEXT<'static> {
+    vk::DebugUtilsMessengerCreateInfoEXT::default()
         .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING)
         .message_type(
             // Performance hints are left out: they flag lookdev's deliberate use of the GENERAL layout.
             vk::DebugUtilsMessageTypeFlagsEXT::GENERAL | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION,
         )
         .pfn_user_callback(Some(debug_callback))
-        .user_data(Arc::as_ptr(counter) as *mut c_void);
-    let messenger = unsafe { loader.create_debug_utils_messenger(&messenger_info, None) }?;
-    Ok((instance, Some((loader, messenger))))
+        .user_data(Arc::as_ptr(counter) as *mut c_void)
 }
 
-fn destroy_instance(instance: &ash::Instance, debug: &DebugMessenger) {
-    unsafe {
-        if let Some((loader, messenger)) = debug {
-            loader.destroy_debug_utils_messenger(*messenger, None);
-        }
-        instance.destroy_instance(None);
-    }
-}
-
-fn pick_and_create_device(
-    entry: ash::Entry,
-    instance: ash::Instance,
-    debug: DebugMessenger,
-    options: &ContextOptions,
-    surface: Option<vk::SurfaceKHR>,
-    counter: Arc<ValidationCounter>,
-) -> Result<Shared> {
-    // From here on, a failure must still destroy the surface and the instance.
-    let surface_loader = ash::khr::surface::Instance::new(&entry, &instance);
-    let give_up = |instance: &ash::Instance, debug: &DebugMessenger| {
-        if let Some(surface) = surface {
-            unsafe { surface_loader.destroy_surface(surface, None) };
-        }
-        destroy_instance(instance, debug);
-    };
+/// Chooses the device and creates it, with its queue and command pool, for the caller's surface
+/// if there is one.
+fn create_device(instance: Arc<Instance>, options: &ContextOptions, surface: Option<&Surface>) -> Result<Shared> {
     let presents = |pd: vk::PhysicalDevice, family: u32| match surface {
         Some(surface) => {
-            unsafe { surface_loader.get_physical_device_surface_support(pd, family, surface) }.unwrap_or(false)
+            unsafe { surface.loader.get_physical_device_surface_support(pd, family, surface.handle) }.unwrap_or(false)
         }
         None => true,
     };
     let (physical_device, queue_family, info) =
-        match choose_physical_device(&instance, options, options.graphics || surface.is_some(), &presents) {
-            Ok(chosen) => chosen,
-            Err(e) => {
-                give_up(&instance, &debug);
-                return Err(e);
-            }
-        };
+        choose_physical_device(&instance, options, options.graphics || surface.is_some(), &presents)?;
     let priorities = [1.0f32];
     let queue_info =
         [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
@@ -384,40 +421,29 @@ fn pick_and_create_device(
         .queue_create_infos(&queue_info)
         .enabled_extension_names(&extensions)
         .push_next(&mut features13);
-    let device = match unsafe { instance.create_device(physical_device, &device_info, None) } {
-        Ok(device) => device,
-        Err(e) => {
-            give_up(&instance, &debug);
-            return Err(Error::gpu(format!("cannot create a Vulkan device on {} ({e})", info.name)));
-        }
-    };
+    inject::check(Step::Device)?;
+    let device = unsafe { instance.create_device(physical_device, &device_info, None) }
+        .map_err(|e| Error::gpu(format!("cannot create a Vulkan device on {} ({e})", info.name)))?;
     let queue = unsafe { device.get_device_queue(queue_family, 0) };
     let memory_properties = unsafe { instance.get_physical_device_memory_properties(physical_device) };
-    let pool_info = vk::CommandPoolCreateInfo::default()
-        .queue_family_index(queue_family)
-        .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
-    let command_pool = match unsafe { device.create_command_pool(&pool_info, None) } {
-        Ok(pool) => pool,
-        Err(e) => {
-            unsafe { device.destroy_device(None) };
-            give_up(&instance, &debug);
-            return Err(e.into());
-        }
-    };
-    Ok(Shared {
-        entry,
+    // From here on, Drop releases whatever has been created if a later step fails.
+    let mut shared = Shared {
         instance,
-        debug,
         physical_device,
         device,
         queue,
         queue_family,
         memory_properties,
         info,
-        command_pool,
+        command_pool: vk::CommandPool::null(),
         submission: std::sync::Mutex::new(()),
-        _counter: counter,
-    })
+    };
+    let pool_info = vk::CommandPoolCreateInfo::default()
+        .queue_family_index(queue_family)
+        .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+    inject::check(Step::CommandPool)?;
+    shared.command_pool = unsafe { shared.device.create_command_pool(&pool_info, None) }?;
+    Ok(shared)
 }
 
 /// The devices lookdev can use (Vulkan 1.3 with a compute queue; with `graphics`, one that also
@@ -487,9 +513,8 @@ pub fn list_devices() -> Result<Vec<(String, String)>> {
     let entry = unsafe { ash::Entry::load() }
         .map_err(|e| Error::gpu(format!("no Vulkan loader found ({e}); {INSTALL_DRIVER}")))?;
     let counter = Arc::new(ValidationCounter::default());
-    let (instance, debug) = create_instance(&entry, false, &[], &counter)?;
+    let instance = create_instance(&entry, false, &[], &counter)?;
     let candidates = candidates(&instance, false, &|_, _| true);
-    destroy_instance(&instance, &debug);
     Ok(candidates?
         .into_iter()
         .map(|(_, _, info)| (info.name, format!("{:?}", info.device_type).to_lowercase().replace('_', " ")))

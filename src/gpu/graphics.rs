@@ -5,6 +5,7 @@
 use super::context::{Context, Shared};
 use super::memory::{Buffer, Image};
 use super::pipeline::BindingKind;
+use super::pipeline::ShaderModule;
 use super::shaders::Stage;
 use crate::{Error, Result};
 use ash::vk;
@@ -53,15 +54,9 @@ pub const fn set_layout(textures: u32) -> [BindingKind; 2] {
 const STAGES: vk::ShaderStageFlags =
     vk::ShaderStageFlags::from_raw(vk::ShaderStageFlags::VERTEX.as_raw() | vk::ShaderStageFlags::FRAGMENT.as_raw());
 
-fn module(ctx: &Context, stage: &Stage) -> Result<vk::ShaderModule> {
-    let code = ash::util::read_spv(&mut std::io::Cursor::new(stage.spirv))
-        .map_err(|e| Error::gpu(format!("shader {}: bad SPIR-V ({e})", stage.file)))?;
-    Ok(unsafe { ctx.device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&code), None) }?)
-}
-
 impl GraphicsPipeline {
     pub fn new(ctx: &Context, desc: &PipelineDesc) -> Result<GraphicsPipeline> {
-        let device = &ctx.device;
+        let device = &ctx.shared.device;
         let bindings: Vec<_> = set_layout(desc.textures)
             .into_iter()
             .enumerate()
@@ -93,22 +88,16 @@ impl GraphicsPipeline {
             vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts).push_constant_ranges(&ranges);
         result.layout = unsafe { device.create_pipeline_layout(&layout_info, None) }?;
 
-        let vertex = module(ctx, desc.vertex)?;
-        let fragment = match module(ctx, desc.fragment) {
-            Ok(fragment) => fragment,
-            Err(e) => {
-                unsafe { device.destroy_shader_module(vertex, None) };
-                return Err(e);
-            }
-        };
+        let vertex = ShaderModule::new(&ctx.shared, desc.vertex.spirv, &format!("shader {}", desc.vertex.file))?;
+        let fragment = ShaderModule::new(&ctx.shared, desc.fragment.spirv, &format!("shader {}", desc.fragment.file))?;
         let stages = [
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::VERTEX)
-                .module(vertex)
+                .module(vertex.handle)
                 .name(c"main"),
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::FRAGMENT)
-                .module(fragment)
+                .module(fragment.handle)
                 .name(c"main"),
         ];
         let binding = [vk::VertexInputBindingDescription::default()
@@ -167,10 +156,6 @@ impl GraphicsPipeline {
             .layout(result.layout)
             .push_next(&mut rendering);
         let created = unsafe { device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) };
-        unsafe {
-            device.destroy_shader_module(vertex, None);
-            device.destroy_shader_module(fragment, None);
-        }
         result.pipeline = created.map_err(|(_, e)| {
             Error::gpu(format!("pipeline {} + {}: creation failed ({e})", desc.vertex.file, desc.fragment.file))
         })?[0];
@@ -325,7 +310,7 @@ impl Sampler {
             .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .mipmap_mode(desc.mipmap.unwrap_or(vk::SamplerMipmapMode::NEAREST))
             .max_lod(if desc.mipmap.is_some() { vk::LOD_CLAMP_NONE } else { 0.0 });
-        let sampler = unsafe { ctx.device.create_sampler(&info, None) }?;
+        let sampler = unsafe { ctx.shared.device.create_sampler(&info, None) }?;
         Ok(Sampler { shared: ctx.shared.clone(), sampler })
     }
 }

@@ -72,7 +72,7 @@ impl Buffer {
     fn new(ctx: &Context, size: u64, usage: vk::BufferUsageFlags, host_visible: bool) -> Result<Buffer> {
         let size = size.max(16);
         let info = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
-        let buffer = unsafe { ctx.device.create_buffer(&info, None) }?;
+        let buffer = unsafe { ctx.shared.device.create_buffer(&info, None) }?;
         // From here on, Drop releases whatever has been created if a later step fails.
         let mut result =
             Buffer { shared: ctx.shared.clone(), buffer, memory: vk::DeviceMemory::null(), size, mapped: None };
@@ -115,7 +115,7 @@ impl Buffer {
         staging.bytes_mut()[..data.len()].copy_from_slice(data);
         ctx.run(|cmd| {
             let region = vk::BufferCopy::default().size(data.len().max(1) as u64);
-            unsafe { ctx.device.cmd_copy_buffer(cmd, staging.buffer, self.buffer, &[region]) };
+            unsafe { ctx.shared.device.cmd_copy_buffer(cmd, staging.buffer, self.buffer, &[region]) };
             Ok(())
         })?;
         Ok(self)
@@ -126,7 +126,7 @@ impl Buffer {
         let staging = Buffer::staging(ctx, self.size)?;
         ctx.run(|cmd| {
             let region = vk::BufferCopy::default().size(self.size);
-            unsafe { ctx.device.cmd_copy_buffer(cmd, self.buffer, staging.buffer, &[region]) };
+            unsafe { ctx.shared.device.cmd_copy_buffer(cmd, self.buffer, staging.buffer, &[region]) };
             Ok(())
         })?;
         Ok(staging.bytes().to_vec())
@@ -295,7 +295,7 @@ impl Image {
             .flags(if sampled_as_srgb { vk::ImageCreateFlags::MUTABLE_FORMAT } else { vk::ImageCreateFlags::empty() })
             .sharing_mode(vk::SharingMode::EXCLUSIVE)
             .initial_layout(vk::ImageLayout::UNDEFINED);
-        let image = unsafe { ctx.device.create_image(&info, None) }?;
+        let image = unsafe { ctx.shared.device.create_image(&info, None) }?;
         // From here on, Drop releases whatever has been created if a later step fails.
         let mut result = Image {
             shared: ctx.shared.clone(),
@@ -396,7 +396,13 @@ impl Image {
     fn copy_from(&self, ctx: &Context, staging: &Buffer, regions: &[vk::BufferImageCopy]) -> Result<()> {
         ctx.run(|cmd| {
             unsafe {
-                ctx.device.cmd_copy_buffer_to_image(cmd, staging.buffer, self.image, vk::ImageLayout::GENERAL, regions)
+                ctx.shared.device.cmd_copy_buffer_to_image(
+                    cmd,
+                    staging.buffer,
+                    self.image,
+                    vk::ImageLayout::GENERAL,
+                    regions,
+                )
             };
             Ok(())
         })

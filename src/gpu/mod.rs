@@ -4,13 +4,15 @@
 
 pub mod context;
 pub mod graphics;
+#[doc(hidden)]
+pub mod inject;
 pub mod interface;
 pub mod memory;
 pub mod pipeline;
 pub mod shaders;
 pub mod timer;
 
-pub use context::{Context, ContextOptions, DeviceInfo, Presentation};
+pub use context::{Context, ContextOptions, DeviceInfo, Presentation, Surface};
 pub use interface::{GlslLayout, GlslStruct, Interface};
 pub use memory::{Buffer, Image};
 pub use pipeline::{Binding, BindingKind, ComputePipeline, DescriptorSet};

@@ -1,6 +1,7 @@
 //! Compute pipelines from committed SPIR-V, and their descriptor sets.
 
 use super::context::{Context, Shared};
+use super::inject::{self, Step};
 use super::memory::{Buffer, Image};
 use super::shaders::Kernel;
 use crate::{Error, Result};
@@ -31,6 +32,29 @@ impl BindingKind {
             BindingKind::Textures(count) => count,
             _ => 1,
         }
+    }
+}
+
+/// A shader module for as long as pipelines are being made from it: destroyed when dropped.
+pub(crate) struct ShaderModule<'a> {
+    device: &'a ash::Device,
+    pub(crate) handle: vk::ShaderModule,
+}
+
+impl<'a> ShaderModule<'a> {
+    /// `what` names the SPIR-V in errors.
+    pub(crate) fn new(shared: &'a Shared, spirv: &[u8], what: &str) -> Result<ShaderModule<'a>> {
+        let code = ash::util::read_spv(&mut std::io::Cursor::new(spirv))
+            .map_err(|e| Error::gpu(format!("{what}: bad SPIR-V ({e})")))?;
+        let info = vk::ShaderModuleCreateInfo::default().code(&code);
+        let handle = unsafe { shared.device.create_shader_module(&info, None) }?;
+        Ok(ShaderModule { device: &shared.device, handle })
+    }
+}
+
+impl Drop for ShaderModule<'_> {
+    fn drop(&mut self) {
+        unsafe { self.device.destroy_shader_module(self.handle, None) };
     }
 }
 
@@ -66,12 +90,18 @@ impl ComputePipeline {
         push_size: u32,
         constants: &[u32],
     ) -> Result<ComputePipeline> {
-        let device = &ctx.device;
-        let code = ash::util::read_spv(&mut std::io::Cursor::new(kernel.spirv))
-            .map_err(|e| Error::gpu(format!("kernel {}: bad SPIR-V ({e})", kernel.name)))?;
-        let module = unsafe { device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&code), None) }?;
-
-        let mut set_layouts = Vec::new();
+        let device = &ctx.shared.device;
+        // From here on, Drop releases whatever has been created if a later step fails.
+        let mut result = ComputePipeline {
+            shared: ctx.shared.clone(),
+            name: kernel.name,
+            pipeline: vk::Pipeline::null(),
+            layout: vk::PipelineLayout::null(),
+            set_layouts: Vec::new(),
+            set_kinds: sets.iter().map(|s| s.to_vec()).collect(),
+            push_size,
+        };
+        let module = ShaderModule::new(&ctx.shared, kernel.spirv, &format!("kernel {}", kernel.name))?;
         for kinds in sets {
             let bindings: Vec<_> = kinds
                 .iter()
@@ -85,14 +115,16 @@ impl ComputePipeline {
                 })
                 .collect();
             let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
-            set_layouts.push(unsafe { device.create_descriptor_set_layout(&info, None) }?);
+            inject::check(Step::SetLayout)?;
+            result.set_layouts.push(unsafe { device.create_descriptor_set_layout(&info, None) }?);
         }
         let ranges = [vk::PushConstantRange::default().stage_flags(vk::ShaderStageFlags::COMPUTE).size(push_size)];
-        let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
+        let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&result.set_layouts);
         if push_size > 0 {
             layout_info = layout_info.push_constant_ranges(&ranges);
         }
-        let layout = unsafe { device.create_pipeline_layout(&layout_info, None) }?;
+        inject::check(Step::PipelineLayout)?;
+        result.layout = unsafe { device.create_pipeline_layout(&layout_info, None) }?;
         let entries: Vec<vk::SpecializationMapEntry> = (0..constants.len() as u32)
             .map(|i| vk::SpecializationMapEntry::default().constant_id(i).offset(4 * i).size(4))
             .collect();
@@ -100,25 +132,16 @@ impl ComputePipeline {
             vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(constants));
         let mut stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
-            .module(module)
+            .module(module.handle)
             .name(c"main");
         if !constants.is_empty() {
             stage = stage.specialization_info(&specialization);
         }
-        let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout);
-        let pipeline = unsafe { device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
-        unsafe { device.destroy_shader_module(module, None) };
-        let pipeline = pipeline
+        let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(result.layout);
+        inject::check(Step::Pipeline)?;
+        result.pipeline = unsafe { device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) }
             .map_err(|(_, e)| Error::gpu(format!("kernel {}: pipeline creation failed ({e})", kernel.name)))?[0];
-        Ok(ComputePipeline {
-            shared: ctx.shared.clone(),
-            name: kernel.name,
-            pipeline,
-            layout,
-            set_layouts,
-            set_kinds: sets.iter().map(|s| s.to_vec()).collect(),
-            push_size,
-        })
+        Ok(result)
     }
 
     /// Makes descriptor set `set` from `bindings`, which must match the layout.
@@ -146,6 +169,7 @@ impl ComputePipeline {
 
 impl Drop for ComputePipeline {
     fn drop(&mut self) {
+        // Destroying a null handle does nothing, so a half-made pipeline drops cleanly.
         unsafe {
             let device = &self.shared.device;
             device.destroy_pipeline(self.pipeline, None);
@@ -161,7 +185,7 @@ impl Drop for ComputePipeline {
 pub struct DescriptorSet {
     shared: Arc<Shared>,
     pool: vk::DescriptorPool,
-    pub set: vk::DescriptorSet,
+    pub(crate) set: vk::DescriptorSet,
 }
 
 impl DescriptorSet {
@@ -182,15 +206,12 @@ impl DescriptorSet {
             .collect();
         let pool_info = vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes);
         let pool = unsafe { device.create_descriptor_pool(&pool_info, None) }?;
+        // From here on, Drop releases whatever has been created if a later step fails.
+        let mut result = DescriptorSet { shared: shared.clone(), pool, set: vk::DescriptorSet::null() };
         let layouts = [layout];
         let alloc = vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts);
-        let set = match unsafe { device.allocate_descriptor_sets(&alloc) } {
-            Ok(sets) => sets[0],
-            Err(e) => {
-                unsafe { device.destroy_descriptor_pool(pool, None) };
-                return Err(e.into());
-            }
-        };
+        let set = unsafe { device.allocate_descriptor_sets(&alloc) }?[0];
+        result.set = set;
         let image_infos: Vec<[vk::DescriptorImageInfo; 1]> = bindings
             .iter()
             .map(|b| match b {
@@ -232,7 +253,7 @@ impl DescriptorSet {
             })
             .collect();
         unsafe { device.update_descriptor_sets(&writes, &[]) };
-        Ok(DescriptorSet { shared: shared.clone(), pool, set })
+        Ok(result)
     }
 }
 

@@ -20,7 +20,7 @@ impl GpuTimer {
             return Ok(None);
         };
         let info = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(2 * pairs);
-        let pool = unsafe { ctx.device.create_query_pool(&info, None) }?;
+        let pool = unsafe { ctx.shared.device.create_query_pool(&info, None) }?;
         Ok(Some(GpuTimer { shared: ctx.shared.clone(), pool, pairs, period_ns }))
     }
 

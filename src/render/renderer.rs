@@ -256,7 +256,7 @@ impl Renderer {
             end_row: first_row + rows.min(self.height.saturating_sub(first_row)),
         };
         self.finalize.record(cmd, self.width, &push);
-        crate::gpu::context::full_barrier(&self.ctx.device, cmd);
+        crate::gpu::context::full_barrier(&self.ctx.shared.device, cmd);
     }
 
     /// Makes the display pixels (and linear radiance) of rows `first_row..first_row + rows` from

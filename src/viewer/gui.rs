@@ -36,9 +36,9 @@ impl Gui {
         let egui = egui::Context::default();
         let state = egui_winit::State::new(egui.clone(), egui::ViewportId::ROOT, window, None, None, None);
         let renderer = Renderer::with_default_allocator(
-            &ctx.instance,
-            ctx.physical_device,
-            ctx.device.clone(),
+            &ctx.shared.instance,
+            ctx.shared.physical_device,
+            ctx.shared.device.clone(),
             RenderMode::DynamicRendering(DynamicRendering {
                 color_attachment_format: presenter.format,
                 depth_attachment_format: None,
@@ -63,7 +63,7 @@ impl Gui {
             }
         }
         self.release_view_texture(slot);
-        let device = &self.ctx.device;
+        let device = &self.ctx.shared.device;
         let layout = egui_ash_renderer::vulkan::create_vulkan_descriptor_set_layout(device).map_err(renderer_error)?;
         let sizes =
             [vk::DescriptorPoolSize::default().ty(vk::DescriptorType::COMBINED_IMAGE_SAMPLER).descriptor_count(1)];
@@ -102,7 +102,7 @@ impl Gui {
     pub fn release_view_texture(&mut self, slot: usize) {
         if let Some(texture) = self.view_textures[slot].take() {
             self.renderer.remove_user_texture(texture.id);
-            let device = &self.ctx.device;
+            let device = &self.ctx.shared.device;
             unsafe {
                 let _ = device.device_wait_idle();
                 device.destroy_descriptor_pool(texture.pool, None);
@@ -141,11 +141,13 @@ impl Gui {
         for (id, deltas) in &output.textures_delta.set {
             for delta in deltas {
                 let _queue = self.ctx.lock_queue();
-                self.renderer.set_texture(self.ctx.queue, presenter.pool(), *id, delta).map_err(renderer_error)?;
+                self.renderer
+                    .set_texture(self.ctx.shared.queue, presenter.pool(), *id, delta)
+                    .map_err(renderer_error)?;
             }
         }
         let renderer = &mut self.renderer;
-        let device = self.ctx.device.clone();
+        let device = self.ctx.shared.device.clone();
         let captured = presenter.frame(capture, |cmd, view, extent| {
             let attachments = [vk::RenderingAttachmentInfo::default()
                 .image_view(view)
@@ -163,7 +165,7 @@ impl Gui {
             Ok(())
         })?;
         if !output.textures_delta.free.is_empty() {
-            unsafe { self.ctx.device.device_wait_idle() }?;
+            unsafe { self.ctx.shared.device.device_wait_idle() }?;
             for id in &output.textures_delta.free {
                 self.renderer.free_texture(*id).map_err(renderer_error)?;
             }
@@ -175,7 +177,7 @@ impl Gui {
 impl Drop for Gui {
     fn drop(&mut self) {
         unsafe {
-            let _ = self.ctx.device.device_wait_idle();
+            let _ = self.ctx.shared.device.device_wait_idle();
         }
         self.release_view_texture(0);
         self.release_view_texture(1);

@@ -2,16 +2,18 @@
 //! window's contents for screenshots.
 
 use crate::gpu::context::{full_barrier, host_barrier};
-use crate::gpu::{Buffer, Context};
+use crate::gpu::inject::{self, Step};
+use crate::gpu::{Buffer, Context, Surface};
 use crate::{Error, Result};
 use ash::vk;
 
-/// The swapchain and what a frame needs to reach the screen.
+/// The swapchain and what a frame needs to reach the screen. Every handle is null until made, and
+/// Drop destroys the ones made, so a presenter that fails part-way through `new` drops cleanly.
 pub struct Presenter {
     ctx: Context,
-    surface_loader: ash::khr::surface::Instance,
     swapchain_loader: ash::khr::swapchain::Device,
-    surface: vk::SurfaceKHR,
+    /// Dropped after [`Presenter::drop`] has destroyed the swapchain made on it.
+    surface: Surface,
     swapchain: vk::SwapchainKHR,
     images: Vec<vk::Image>,
     views: Vec<vk::ImageView>,
@@ -33,25 +35,13 @@ pub struct Presenter {
 const PREFERRED_FORMATS: [vk::Format; 2] = [vk::Format::B8G8R8A8_SRGB, vk::Format::R8G8B8A8_SRGB];
 
 impl Presenter {
-    /// Takes ownership of `surface`, which must belong to `ctx`'s instance.
-    pub fn new(ctx: &Context, surface: vk::SurfaceKHR, width: u32, height: u32) -> Result<Presenter> {
-        let surface_loader = ash::khr::surface::Instance::new(&ctx.entry, &ctx.instance);
-        let swapchain_loader = ash::khr::swapchain::Device::new(&ctx.instance, &ctx.device);
-        let device = &ctx.device;
-        let pool_info = vk::CommandPoolCreateInfo::default()
-            .queue_family_index(ctx.queue_family)
-            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
-        let pool = unsafe { device.create_command_pool(&pool_info, None) }?;
-        let alloc = vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(1);
-        let command_buffer = unsafe { device.allocate_command_buffers(&alloc) }?[0];
-        let image_available = unsafe { device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }?;
-        let in_flight = unsafe {
-            device.create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None)
-        }?;
+    /// Presents on `surface`, which must belong to `ctx`'s instance.
+    pub fn new(ctx: &Context, surface: Surface, width: u32, height: u32) -> Result<Presenter> {
+        let device = &ctx.shared.device;
+        // From here on, Drop releases whatever has been created if a later step fails.
         let mut presenter = Presenter {
             ctx: ctx.clone(),
-            surface_loader,
-            swapchain_loader,
+            swapchain_loader: ash::khr::swapchain::Device::new(&ctx.shared.instance, device),
             surface,
             swapchain: vk::SwapchainKHR::null(),
             images: Vec::new(),
@@ -59,13 +49,25 @@ impl Presenter {
             format: vk::Format::UNDEFINED,
             extent: vk::Extent2D { width, height },
             capturable: false,
-            pool,
-            command_buffer,
-            image_available,
+            pool: vk::CommandPool::null(),
+            command_buffer: vk::CommandBuffer::null(),
+            image_available: vk::Semaphore::null(),
             render_finished: Vec::new(),
-            in_flight,
+            in_flight: vk::Fence::null(),
             stale: true,
         };
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(ctx.shared.queue_family)
+            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        presenter.pool = unsafe { device.create_command_pool(&pool_info, None) }?;
+        let alloc = vk::CommandBufferAllocateInfo::default().command_pool(presenter.pool).command_buffer_count(1);
+        // Freed with the pool.
+        presenter.command_buffer = unsafe { device.allocate_command_buffers(&alloc) }?[0];
+        presenter.image_available = unsafe { device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }?;
+        inject::check(Step::PresenterFence)?;
+        presenter.in_flight = unsafe {
+            device.create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None)
+        }?;
         presenter.rebuild(width, height)?;
         Ok(presenter)
     }
@@ -87,11 +89,12 @@ impl Presenter {
     }
 
     fn rebuild(&mut self, width: u32, height: u32) -> Result<()> {
-        let device = self.ctx.device.clone();
+        let device = self.ctx.shared.device.clone();
         unsafe { device.device_wait_idle() }?;
-        let pd = self.ctx.physical_device;
-        let caps = unsafe { self.surface_loader.get_physical_device_surface_capabilities(pd, self.surface) }?;
-        let formats = unsafe { self.surface_loader.get_physical_device_surface_formats(pd, self.surface) }?;
+        let pd = self.ctx.shared.physical_device;
+        let surface = &self.surface;
+        let caps = unsafe { surface.loader.get_physical_device_surface_capabilities(pd, surface.handle) }?;
+        let formats = unsafe { surface.loader.get_physical_device_surface_formats(pd, surface.handle) }?;
         let format = PREFERRED_FORMATS
             .iter()
             .find_map(|wanted| formats.iter().find(|f| f.format == *wanted))
@@ -121,7 +124,7 @@ impl Presenter {
             (caps.min_image_count + 1).min(if caps.max_image_count > 0 { caps.max_image_count } else { u32::MAX });
         let old = self.swapchain;
         let info = vk::SwapchainCreateInfoKHR::default()
-            .surface(self.surface)
+            .surface(surface.handle)
             .min_image_count(count)
             .image_format(format.format)
             .image_color_space(format.color_space)
@@ -147,6 +150,9 @@ impl Presenter {
                 .view_type(vk::ImageViewType::TYPE_2D)
                 .format(format.format)
                 .subresource_range(color_range());
+            if self.views.is_empty() {
+                inject::check(Step::SwapchainView)?;
+            }
             self.views.push(unsafe { device.create_image_view(&view_info, None) }?);
             self.render_finished.push(unsafe { device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }?);
         }
@@ -157,7 +163,7 @@ impl Presenter {
     }
 
     fn destroy_swapchain_parts(&mut self) {
-        let device = &self.ctx.device;
+        let device = &self.ctx.shared.device;
         unsafe {
             for view in self.views.drain(..) {
                 device.destroy_image_view(view, None);
@@ -184,7 +190,7 @@ impl Presenter {
         if self.extent.width == 0 || self.extent.height == 0 {
             return Ok(None);
         }
-        let device = self.ctx.device.clone();
+        let device = self.ctx.shared.device.clone();
         unsafe { device.wait_for_fences(&[self.in_flight], true, u64::MAX) }?;
         let acquired = unsafe {
             self.swapchain_loader.acquire_next_image(self.swapchain, u64::MAX, self.image_available, vk::Fence::null())
@@ -271,12 +277,12 @@ impl Presenter {
             .signal_semaphores(&signals);
         let presented = {
             let _queue = self.ctx.lock_queue();
-            unsafe { device.queue_submit(self.ctx.queue, &[submit], self.in_flight) }?;
+            unsafe { device.queue_submit(self.ctx.shared.queue, &[submit], self.in_flight) }?;
             let swapchains = [self.swapchain];
             let indices = [index];
             let present =
                 vk::PresentInfoKHR::default().wait_semaphores(&signals).swapchains(&swapchains).image_indices(&indices);
-            unsafe { self.swapchain_loader.queue_present(self.ctx.queue, &present) }
+            unsafe { self.swapchain_loader.queue_present(self.ctx.shared.queue, &present) }
         };
         match presented {
             Ok(false) => {}
@@ -331,12 +337,12 @@ fn transition(
 
 impl Drop for Presenter {
     fn drop(&mut self) {
-        let device = self.ctx.device.clone();
+        // Destroying a null handle does nothing; the surface drops after this, with the fields.
+        let device = self.ctx.shared.device.clone();
         unsafe {
             let _ = device.device_wait_idle();
             self.destroy_swapchain_parts();
             self.swapchain_loader.destroy_swapchain(self.swapchain, None);
-            self.surface_loader.destroy_surface(self.surface, None);
             device.destroy_semaphore(self.image_available, None);
             device.destroy_fence(self.in_flight, None);
             device.destroy_command_pool(self.pool, None);

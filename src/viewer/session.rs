@@ -295,7 +295,7 @@ impl Session {
     /// Lets go of B sides that were replaced or turned off, once the GPU is done with them.
     pub fn drop_retired(&mut self) -> Result<()> {
         if !self.retired.is_empty() {
-            unsafe { self.ctx.device.device_wait_idle() }?;
+            unsafe { self.ctx.shared.device.device_wait_idle() }?;
             self.retired.clear();
         }
         Ok(())
