@@ -51,7 +51,7 @@ struct RelightPush {
 }
 
 /// What the relight kernel accumulates beside the total, for the AOVs that need it
-/// (docs/formats.md: AOVs). What is off costs nothing: the kernel is specialised without it,
+/// (docs/formats.md#aovs). What is off costs nothing: the kernel is specialised without it,
 /// and a 1×1 placeholder stands for its image.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Accumulate {
@@ -185,7 +185,7 @@ impl Renderer {
         Renderer::with_model(ctx, gbuffer, environment, &Model::default())
     }
 
-    /// A renderer of a BRDF model (docs/shading.md: BRDF models).
+    /// A renderer of a BRDF model (docs/shading.md#brdf-models).
     pub fn with_model(ctx: &Context, gbuffer: &GBuffer, environment: &Environment, model: &Model) -> Result<Renderer> {
         let (width, height) = (gbuffer.width, gbuffer.height);
         let image = BindingKind::StorageImage;
