@@ -1,5 +1,6 @@
 #version 460
-// The bake's geometry pass: one g-buffer sample of the nearest surface (docs/commands.md: lookdev bake).
+// The bake's geometry pass: one g-buffer sample of the nearest surface
+// (docs/commands.md#lookdev-bake-modelgltfglb---out-gbufferexr).
 // Writes the shading normal (the normal map applied through the MikkTSpace tangent frame), the
 // tangent (turned by the material's anisotropy rotation), the view vector, the object and
 // material, and COLOR_0. Back faces of double-sided materials turn their whole frame around, as

@@ -1,6 +1,6 @@
 #version 460
 // The bake's maps pass: the scene drawn again, as bake.frag draws it, for each material's textures
-// as the values of the maps its look binds (docs/commands.md: lookdev bake, and src/asset/materials.rs:
+// as the values of the maps its look binds (docs/commands.md#maps, and src/asset/materials.rs:
 // MapKind). The textures' factors stay in the presets, except where a parameter is not linear in
 // its texture: there the map holds the parameter itself. Each sample says which material it is
 // of, so that it counts for that material's maps whatever the geometry pass saw there.

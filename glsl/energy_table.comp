@@ -1,5 +1,5 @@
 #version 460
-// Builds the energy-compensation table of a model (docs/shading.md: BRDF models): the directional albedo
+// Builds the energy-compensation table of a model (docs/shading.md#brdf-models): the directional albedo
 // E(μ, roughness) of its single-scattering specular lobe with F = 1, for the model's D and G (the
 // pipeline's specialization), by a deterministic midpoint quadrature of the model's own specular
 // sampler: E = ∫ f·cosθl dl = mean of f·cosθl/pdf over the sampler's unit square. One invocation

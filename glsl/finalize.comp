@@ -1,5 +1,5 @@
 #version 460
-// Turns the running sums of a band of rows into the image (docs/formats.md: Output): each pixel's mean
+// Turns the running sums of a band of rows into the image (docs/formats.md#output): each pixel's mean
 // estimate, composited over the background by coverage, as linear radiance (for EXR); and, through exposure 2^EV, the tone
 // map and the sRGB OETF, as 8-bit display pixels (for PNG and the viewer).
 //

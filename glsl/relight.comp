@@ -1,7 +1,7 @@
 #version 460
 // One progressive pass of image-based relighting over a band of rows: for each covered pixel and
 // each sample index, one environment sample and one BRDF sample, combined with the power heuristic
-// (docs/shading.md: Sampling). The running float32 sum of the estimates is accumulated in sample order, so
+// (docs/shading.md#sampling). The running float32 sum of the estimates is accumulated in sample order, so
 // any split into passes and bands gives the same bits. Coverage and the background are composited
 // by finalize.comp, so background pixels cost nothing after the first pass of an accumulation.
 // Every pixel of a band has the same number of samples so far; keeping that number (and so the
@@ -14,7 +14,7 @@ layout(local_size_x = 16, local_size_y = 16) in;
 #define ENERGY_TABLE_SET 0
 #define ENERGY_TABLE_BINDING 4
 
-// What is accumulated beside the total, only when asked for (docs/formats.md: AOVs): each
+// What is accumulated beside the total, only when asked for (docs/formats.md#aovs): each
 // lobe's share of every estimate, and the sum of each estimate's squared luminance. Off, the
 // code below is specialised away and the images bound are 1×1 placeholders.
 layout(constant_id = 6) const uint LOBE_AOVS = 0u;

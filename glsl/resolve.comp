@@ -1,5 +1,5 @@
 #version 460
-// Resolves each pixel's layer stack into one material, parameter by parameter (docs/formats.md: Formats).
+// Resolves each pixel's layer stack into one material, parameter by parameter (docs/formats.md#looks).
 // A layer's value at a pixel is its own value times, for each parameter bound to a map, the
 // map's value there. The bottom layer fills, and each layer above blends in with
 // w = clamp(opacity·m, 0, 1), where m is its mask (or 1 − mask when inverted; 1 without a mask).

@@ -5,7 +5,7 @@
         [--matte-material NAME]... [--matte-attribute NAME]...
 
 It renders the scene's active camera with Cycles into one multilayer OpenEXR holding what
-lookdev reads (docs/formats.md: Production renders):
+lookdev reads (docs/formats.md#production-renders):
 
 - the Normal and Position passes (world space, Z up), and Depth;
 - Cryptomatte object, material and asset layers (ids, coverage, names and mattes);

@@ -1,4 +1,4 @@
-//! The BRDF lab's model variants (docs/shading.md: BRDF models): every distribution is normalised, every
+//! The BRDF lab's model variants (docs/shading.md#brdf-models): every distribution is normalised, every
 //! shadowing term passes the weak white furnace, every diffuse model reflects what numerical
 //! integration says (closed forms where they exist), conductor Fresnel meets its normal-incidence
 //! formula, energy compensation keeps a white rough metal at 1, the renderer's furnace agrees

@@ -1,5 +1,5 @@
-// The Disney 2012 principled BRDF, BRDF Explorer revision (docs/shading.md: Shading model), and the BRDF
-// lab's variants of its diffuse, D, G and F terms (docs/shading.md: BRDF models), chosen by the
+// The Disney 2012 principled BRDF, BRDF Explorer revision (docs/shading.md#shading-model), and the BRDF
+// lab's variants of its diffuse, D, G and F terms (docs/shading.md#brdf-models), chosen by the
 // specialization constants of model.glsl. With the default constants every function computes
 // exactly what the Disney model computes.
 //

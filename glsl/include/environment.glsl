@@ -1,4 +1,5 @@
-// The environment: lat-long mapping, radiance lookups and importance sampling (docs/formats.md: Environments, Sampling).
+// The environment: lat-long mapping, radiance lookups and importance sampling
+// (docs/formats.md#environments, docs/shading.md#sampling).
 //
 // Directions here are in environment space: the world direction rotated by R_y(−rotation).
 // u = 0.5 + atan2(d.x, −d.z)/2π (wrapped into [0, 1)), v = acos(d.y)/π, row 0 the zenith.

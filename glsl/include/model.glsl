@@ -1,4 +1,4 @@
-// The BRDF model variants of the BRDF lab (docs/shading.md: BRDF models). Every kernel that shades is one
+// The BRDF model variants of the BRDF lab (docs/shading.md#brdf-models). Every kernel that shades is one
 // pipeline per model: the choices are specialization constants, whose defaults are the Disney 2012
 // model, so the driver folds every branch on them away and no kernel is copied per model.
 // Mirrored by src/shading/model.rs (Model::specialization writes these constant ids in order).

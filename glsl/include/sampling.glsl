@@ -1,4 +1,4 @@
-// BRDF importance sampling and multiple importance sampling (docs/shading.md: Sampling).
+// BRDF importance sampling and multiple importance sampling (docs/shading.md#sampling).
 //
 // Directions are in the shading frame (N = +Z). Every sampler has a matching pdf, over solid
 // angle, that accounts for every direction it can produce. The samplers take the azimuth as

@@ -1,10 +1,11 @@
-//! Baking: an asset rasterized into a g-buffer (docs/commands.md: lookdev bake).
+//! Baking: an asset rasterized into a g-buffer
+//! (docs/commands.md#lookdev-bake-modelgltfglb---out-gbufferexr).
 //!
 //! Each of `samples` passes draws the whole scene with the camera nudged by a sub-pixel offset
 //! (a stratified pattern), and reads back one sample per pixel of every output. A pass draws
 //! twice when a material has textures that drive parameters: once for the geometry (normals,
-//! tangents, view vectors, ids, `COLOR_0`), then again for the maps (docs/commands.md: lookdev bake), each
-//! of whose samples names its material. The passes are averaged on the CPU, as the built-in scene's
+//! tangents, view vectors, ids, `COLOR_0`), then again for the maps (docs/commands.md#maps), each of
+//! whose samples names its material. The passes are averaged on the CPU, as the built-in scene's
 //! subsamples are: coverage is the fraction of samples that hit, normals, tangents and view
 //! vectors are averaged over the hits, the object ID is the one most samples saw, each mask is
 //! the fraction (or mean value) of the samples that carry it, and each map the mean over the

@@ -12,7 +12,7 @@ use glam::camera::rh::proj::vulkan;
 use glam::camera::rh::view::{look_at_mat4, look_to_mat4};
 use glam::{Mat4, Vec3};
 
-/// How the camera is chosen (docs/commands.md: lookdev bake).
+/// How the camera is chosen (docs/commands.md#lookdev-bake-modelgltfglb---out-gbufferexr).
 #[derive(Clone, Debug, PartialEq)]
 pub enum CameraChoice {
     /// The scene's first camera, else framing.

@@ -1,5 +1,6 @@
 //! Importing an asset's materials: one preset per material, and a look that layers them
-//! through the bake's masks and binds their maps (docs/commands.md: lookdev import).
+//! through the bake's masks and binds their maps
+//! (docs/commands.md#lookdev-import-modelgltfglb---presets-dir---look-looktoml---force).
 //!
 //! The look has one stack, the default one, since every object of a baked asset tells its
 //! materials apart by mask rather than by id. The first material fills; each other material is a

@@ -1,5 +1,5 @@
-//! glTF materials as Disney 2012 parameters (docs/commands.md: lookdev import, where each formula is
-//! given), and what the bake needs to know of them.
+//! glTF materials as Disney 2012 parameters (each formula is given in
+//! docs/commands.md#the-material-mapping), and what the bake needs to know of them.
 //!
 //! A preset holds the material's factors. Its textures become g-buffer maps ([`MapKind`]): the
 //! bake samples each texture into the map of the parameter it drives, and the imported look
@@ -12,7 +12,7 @@ use super::Asset;
 use crate::material::{Param, Params};
 use gltf::json::Value;
 
-/// Largest values the look format allows (docs/formats.md: Presets).
+/// Largest values the look format allows (docs/formats.md#presets).
 const SPECULAR_LIMIT: f32 = crate::material::params::SPECULAR_MAX;
 const SHEEN_LIMIT: f32 = crate::material::params::SHEEN_MAX;
 const CLEARCOAT_LIMIT: f32 = crate::material::params::CLEARCOAT_MAX;

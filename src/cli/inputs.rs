@@ -50,7 +50,7 @@ impl SceneArgs {
     }
 }
 
-/// The g-buffer and how to read it (docs/formats.md: Production renders).
+/// The g-buffer and how to read it (docs/formats.md#production-renders).
 #[derive(Args, Debug, Default, Clone)]
 pub struct GBufferArgs {
     /// The g-buffer EXR to relight: lookdev's own, a Blender/Cycles multilayer EXR or Arnold-style

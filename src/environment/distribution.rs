@@ -1,4 +1,4 @@
-//! The environment's importance-sampling tables (docs/shading.md: Sampling).
+//! The environment's importance-sampling tables (docs/shading.md#sampling).
 //!
 //! Lighting treats the map as piecewise constant over its texels, and sampling draws directions
 //! from a density that is piecewise constant *in solid angle* over cells of texels, with each

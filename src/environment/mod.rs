@@ -1,4 +1,4 @@
-//! Environments: equirectangular radiance maps (docs/formats.md: Formats), their importance-sampling tables,
+//! Environments: equirectangular radiance maps (docs/formats.md#environments), their importance-sampling tables,
 //! and their GPU form.
 //!
 //! Convention: row 0 is the zenith (+Y). A unit direction d maps to

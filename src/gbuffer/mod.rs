@@ -1,69 +1,13 @@
 //! The g-buffer: everything the relighter needs per pixel, read from an OpenEXR file or made by
 //! the built-in shader-ball scene.
 //!
-//! # File format
-//!
-//! One single-part scan-line or tiled OpenEXR image. Samples may be half, float or uint; any
-//! compression the `exr` crate reads is accepted (none, RLE, ZIPS, ZIP, PIZ, PXR24, B44, B44A,
-//! DWAA, DWAB). Row 0 is the top of the image; the data window's size is used and its offset
-//! ignored. Channels, by exact name:
-//!
-//! | channel | meaning | if absent |
-//! |---|---|---|
-//! | `N.X N.Y N.Z` | world-space unit shading normal | error (required) |
-//! | `V.X V.Y V.Z` | unit vector from the surface toward the eye | (0,0,1) |
-//! | `T.X T.Y T.Z` | world-space tangent, for anisotropy | [`stable_tangent`] of N |
-//! | `A` | coverage in \[0,1\]; 0 is background | 1 where \|N\| > 0.5, else 0 |
-//! | `objectId` | integer object ID: uint, or half/float holding non-negative integers | 0 |
-//! | `mask.<name>` | layer mask in \[0,1\], named `<name>` in looks | — |
-//! | `map.<name>` | a scalar parameter map in \[0,1\], linear, named `<name>` in looks | — |
-//! | `map.<name>.R .G .B` | a colour parameter map in \[0,1\], linear | — |
-//!
-//! A triple must be complete: `V.X` without `V.Y` is an error. Other channels are ignored.
-//!
-//! # Maps
-//!
-//! A map holds one parameter's texture per pixel. A layer binds a parameter to it in its
-//! `[object.layer.map]` table, and the parameter's value at a pixel is then the layer's value
-//! times the map's: glTF's factor × texture. Three channels `map.<name>.R`, `.G` and `.B` make
-//! the colour map `<name>`, whose single channels are named `<name>.R` and so on; any other
-//! `map.*` channel is a scalar map named by the rest of its channel name. Maps are read and
-//! checked like masks: half or float, NaN/Inf is an error, values outside \[0,1\] are clamped
-//! with a warning. So a bound value never leaves its parameter's range.
-//!
-//! Prefer a lossless compression (ZIP, PIZ) for g-buffers. DWAA and DWAB treat every channel
-//! whose name ends in `.Y` as luminance and quantise it, so `N.Y`, `V.Y` and `T.Y` come back
-//! with errors around 1e-3 while the X and Z components are exact; B44 quantises every half
-//! channel.
-//!
-//! # Object names
-//!
-//! Object names live in the header as text attributes named `objectName.<ID>`, where `<ID>` is
-//! the decimal object ID and the value is the name in UTF-8, for example
-//! `objectName.1 = "ball"`, `objectName.2 = "pedestal"`. They are read on load and written on
-//! save. An attribute whose ID is not a decimal u32, or whose value is not text, is skipped with
-//! a warning.
-//!
-//! # Validation
-//!
-//! A pixel is *covered* where `A > 0`, or, in a file without `A`, wherever N is not a clearly
-//! empty vector (\|N\| ≤ 0.5). Reading fails, with one line naming the file and the problem, on:
-//! a missing file; a file the `exr` crate cannot read; more than one part; an empty image; a
-//! missing `N.*` channel; an incomplete triple; NaN/Inf normals at covered pixels; \|N\| < 0.5
-//! where `A` > 0; NaN/Inf or zero-length view vectors anywhere; NaN/Inf in `A`, a mask or a map; and
-//! object IDs that are negative or not integers. Counts and the first offending pixel are given.
-//!
-//! These are fixed, with one warning line each, naming the file and the count:
-//! normals at covered pixels whose length is off by more than 1% (all normals are renormalised
-//! anyway, since half floats are not exactly unit); `A`, mask and map values outside \[0,1\] (clamped);
-//! tangents at covered pixels that are zero, NaN/Inf or parallel to N (replaced by the stable
-//! frame). Stored tangents are otherwise made orthogonal to N by Gram–Schmidt.
-//!
-//! # Writing, and the built-in scene
-//!
-//! [`GBuffer::write`] stores `N.*` (and `V.*`, `T.*` where the g-buffer has them) as float, `A`
-//! masks and maps as half, `objectId` as uint, ZIP-compressed, through a temporary file that is
-//! renamed into place. [`GBuffer::shaderball`] makes the built-in look-dev scene without a file.
+//! The file format (channels, masks and maps, object and mask names, which problems are errors
+//! and which are fixed with a warning, compression) is specified in docs/formats.md#g-buffers;
+//! other renderers' files are translated into these channels by [`source`]
+//! (docs/formats.md#production-renders). [`GBuffer::write`] stores `N.*` (and `V.*`, `T.*` where
+//! the g-buffer has them) as float, `A`, masks and maps as half and `objectId` as uint,
+//! ZIP-compressed, through a temporary file renamed into place. [`GBuffer::shaderball`] makes the
+//! built-in scene (docs/formats.md#the-built-in-scene) without a file.
 
 mod frame;
 pub mod gpu;

@@ -1,4 +1,4 @@
-//! The BRDF lab (docs/shading.md: BRDF models, `lookdev brdf`): what the plots show, computed from the Rust
+//! The BRDF lab (docs/shading.md#brdf-models, `lookdev brdf`): what the plots show, computed from the Rust
 //! reference of the shaders, so a plot shows exactly what the renderer evaluates.
 //!
 //! - [`directional_albedo`]: E(θv) = ∫ f(l, v)·cosθl dl, by a deterministic quadrature that

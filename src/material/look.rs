@@ -1,45 +1,6 @@
-//! Looks: what to render. A look file (docs/formats.md: Formats) sets the environment, the render
-//! settings, and one layer stack per object:
-//!
-//! ```toml
-//! [environment]          # optional; default: the embedded studio environment
-//! file = "studio.exr"    # relative to the look file's folder
-//! rotation = 0.0         # degrees about +Y; any finite number
-//! intensity = 1.0        # 0 to 1e6
-//! background = true
-//!
-//! [model]                # optional; the BRDF model (docs/shading.md: BRDF models); --model overrides
-//! diffuse = "burley2012" # and specular_d, specular_g, fresnel, gtr_gamma, energy_compensation
-//!
-//! [render]               # optional; command-line flags override
-//! spp = 256              # >= 1
-//! seed = 0               # any u32
-//! exposure = 0.0         # stops; within ±64
-//! tonemap = "neutral"    # linear | neutral | aces | agx
-//! aovs = ["light", "albedo"]  # AOVs written beside the beauty in EXR output
-//!
-//! [[object]]             # a layer stack; without `id` it is the default stack (at most one)
-//! id = 1
-//! [[object.layer]]       # bottom layer first; the bottom layer fills
-//! preset = "blue-rubber" # a library name or a path to a preset file (see `library`)
-//! [[object.layer]]
-//! preset = "gold"
-//! mask = "scratches"     # the g-buffer channel mask.scratches; omitted = 1 everywhere
-//! invert = false
-//! opacity = 1.0          # [0, 1]
-//! enabled = true         # false keeps the layer but leaves it out of the render
-//! [object.layer.set]     # per-parameter overrides on top of the preset
-//! roughness = 0.25
-//! [object.layer.map]     # per-parameter maps: the value here is the layer's times the map's
-//! base_color = "baseColor"     # the g-buffer's colour map map.baseColor.R/G/B
-//! metallic = "metalRough.B"    # one channel of a colour map
-//! roughness = "rough"          # the g-buffer's scalar map map.rough
-//! ```
-//!
-//! A layer without `preset` starts from the default parameters. The bottom layer fills the
-//! object: its mask, invert and opacity are accepted (and written back) but have no effect, and
-//! loading warns about them. A disabled layer is kept (and written back) but not rendered; when
-//! the bottom layer is disabled, the lowest enabled layer fills. Every error is one line,
+//! Looks: what to render. A look file sets the environment, the BRDF model, the render settings,
+//! the g-buffer and one layer stack per object; its keys, the blending rule, map bindings and
+//! how preset names resolve are specified in docs/formats.md#looks. Every error is one line,
 //! `FILE:LINE: problem`, naming the key.
 
 use std::collections::BTreeMap;
@@ -72,7 +33,7 @@ pub struct Look {
 }
 
 /// `[gbuffer]`: the g-buffer file (resolved against the look file's folder) and how to read
-/// it (docs/formats.md: Production renders).
+/// it (docs/formats.md#production-renders).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct GBufferSettings {
     pub file: Option<PathBuf>,
@@ -101,7 +62,7 @@ pub struct RenderSettings {
     /// Exposure in stops.
     pub exposure: Option<f32>,
     pub tonemap: Option<Tonemap>,
-    /// The AOVs renders write beside the beauty (docs/formats.md: AOVs), as written.
+    /// The AOVs renders write beside the beauty (docs/formats.md#aovs), as written.
     pub aovs: Option<Vec<String>>,
 }
 
@@ -233,7 +194,7 @@ impl Look {
     }
 
     /// The look used for a user g-buffer rendered without a look: every object in the default
-    /// material (docs/formats.md: Presets defaults: grey 0.8 dielectric, roughness 0.5), default settings.
+    /// material (docs/formats.md#presets; defaults: grey 0.8 dielectric, roughness 0.5), default settings.
     pub fn default_material() -> Look {
         let mut look = Look {
             file: None,

@@ -1,21 +1,6 @@
-//! Presets: named sets of BRDF parameter values, the building blocks of layer stacks.
-//!
-//! A preset file (`presets/<name>.toml`, a file beside a look, or one in the user's library):
-//!
-//! ```toml
-//! name = "gold"                        # optional; defaults to the file name without .toml
-//! description = "Polished gold: ..."   # optional; what it models, where the numbers come from
-//! tags = ["metal", "measured"]         # optional
-//! base_color = [0.9626, 0.8276, 0.4082]  # linear Rec.709
-//! metallic = 1.0
-//! roughness = 0.25
-//! ```
-//!
-//! Any of the twelve parameters (the eleven of the BRDF, and `emission`) may appear at the top
-//! level; those left out take the defaults
-//! of [`Params::default`]. A metal may also give its complex IOR per channel, `ior_n = [r, g, b]`
-//! and `ior_k = [r, g, b]`, for the `conductor` Fresnel model; its `base_color` must then be their
-//! F0 = ((n−1)² + k²)/((n+1)² + k²), within 0.005. Unknown keys, wrong types, NaN/inf and out-of-range values are
+//! Presets: named sets of BRDF parameter values, the building blocks of layer stacks. The file
+//! format, each parameter's default and range, and the complex IOR of metals are specified in
+//! docs/formats.md#presets. Unknown keys, wrong types, NaN/inf and out-of-range values are
 //! errors of the form `FILE:LINE: problem`.
 
 use std::path::Path;

@@ -1,4 +1,4 @@
-//! AOVs: what a render writes beside the beauty (docs/formats.md: AOVs), each an entry of
+//! AOVs: what a render writes beside the beauty (docs/formats.md#aovs), each an entry of
 //! [`Aov`], computed from the renderer and the scene by [`layers`], as EXR layers named
 //! `<aov>.R .G .B` (or `.Y` for a scalar), as Nuke, Arnold and Blender name them.
 //!

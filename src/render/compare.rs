@@ -1,4 +1,4 @@
-//! A/B comparison of two renders (docs/commands.md: `lookdev render --compare`): the two side by side,
+//! A/B comparison of two renders (docs/commands.md#lookdev-render, `--compare`): the two side by side,
 //! and how far apart they look, as the CIELAB colour difference ΔE*ab of their display pixels.
 
 use super::sheet::{self, Cell, Labeller};

@@ -1,4 +1,4 @@
-//! Writing renders: EXR as linear radiance, PNG as display pixels (docs/formats.md: Output).
+//! Writing renders: EXR as linear radiance, PNG as display pixels (docs/formats.md#output).
 
 use crate::{atomic_file, Error, Result};
 use std::path::Path;
@@ -139,7 +139,7 @@ fn sort_header_attributes(bytes: &mut [u8]) {
 }
 
 /// How a render was made, written into every EXR it produces as text attributes named
-/// `lookdev/<key>` (docs/formats.md: Output).
+/// `lookdev/<key>` (docs/formats.md#output).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Metadata {
     pub entries: Vec<(String, String)>,

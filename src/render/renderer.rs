@@ -60,7 +60,7 @@ impl Renderer {
         Renderer::with_model(ctx, gbuffer, environment, &Model::default())
     }
 
-    /// A renderer of a BRDF model (docs/shading.md: BRDF models).
+    /// A renderer of a BRDF model (docs/shading.md#brdf-models).
     pub fn with_model(ctx: &Context, gbuffer: &GBuffer, environment: &Environment, model: &Model) -> Result<Renderer> {
         let (width, height) = (gbuffer.width, gbuffer.height);
         let gpu_gbuffer = GpuGBuffer::upload(ctx, gbuffer)?;

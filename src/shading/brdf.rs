@@ -1,5 +1,5 @@
 //! Mirror of `glsl/include/brdf.glsl`: the Disney 2012 principled BRDF, BRDF Explorer revision,
-//! and the BRDF lab's variants of its terms (docs/shading.md: BRDF models).
+//! and the BRDF lab's variants of its terms (docs/shading.md#brdf-models).
 //!
 //! Every vector is in the shading frame: N = +Z, tangent X = +X, bitangent Y = +Y. The GLSL reads
 //! the model as specialization constants; here [`Lobes`] and [`View`] carry it, and the energy

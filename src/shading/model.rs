@@ -1,4 +1,4 @@
-//! Mirror of `glsl/include/model.glsl`: the BRDF lab's model variants (docs/shading.md: BRDF models).
+//! Mirror of `glsl/include/model.glsl`: the BRDF lab's model variants (docs/shading.md#brdf-models).
 //!
 //! A [`Model`] picks the diffuse term and the specular D, G and F. The kernels read it as
 //! specialization constants ([`Model::specialization`]), so one kernel serves every model, and the

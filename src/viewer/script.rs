@@ -1,6 +1,8 @@
 //! `--script FILE`: a list of interface actions, one per line, run one per frame through the
-//! same code as the panels (docs/commands.md: `lookdev view`). The whole file is checked before the window
-//! opens; a line that fails while running stops the viewer with the file and line named.
+//! same code as the panels
+//! (docs/commands.md#lookdev-view-looktoml---gbuffer-file---env-file---device-name).
+//! The whole file is checked before the window opens; a line that fails while running stops the
+//! viewer with the file and line named.
 
 use super::action::{Action, Answer, Compare};
 use crate::material::params::{parse_value, Param, Value};

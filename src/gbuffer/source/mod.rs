@@ -1,6 +1,6 @@
 //! G-buffer sources: lookdev's own files, Blender/Cycles multilayer EXRs, Arnold-style AOV EXRs
 //! (single- or multi-part) and, through an explicit mapping, any other renderer's. Each is
-//! translated into lookdev's channels (docs/formats.md: G-buffers) before validation, so
+//! translated into lookdev's channels (docs/formats.md#g-buffers) before validation, so
 //! validation knows one format only:
 //!
 //! 1. the file's parts are merged into one set of named channels ([`raw`]);

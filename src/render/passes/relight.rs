@@ -1,6 +1,6 @@
 //! The relight pass (`relight.comp`): progressive MIS image-based lighting of the resolved
 //! materials, accumulated per pixel, with each lobe's share and each estimate's squared
-//! luminance beside the total when the AOVs ask for them (docs/formats.md: AOVs).
+//! luminance beside the total when the AOVs ask for them (docs/formats.md#aovs).
 
 use super::{groups, Targets};
 use crate::environment::{self, GpuEnvironment};
@@ -62,7 +62,7 @@ crate::glsl_struct!(RelightPush as "Pass", 36 bytes {
 });
 
 /// What the relight kernel accumulates beside the total, for the AOVs that need it
-/// (docs/formats.md: AOVs). What is off costs nothing: the kernel is specialised without it,
+/// (docs/formats.md#aovs). What is off costs nothing: the kernel is specialised without it,
 /// and a 1×1 placeholder stands for its image.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Accumulate {
