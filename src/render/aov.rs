@@ -265,16 +265,37 @@ fn layer_weight_layers(sources: &Sources) -> Vec<Layer> {
             }
         }
         for (i, (layer, values)) in stack.layers.iter().zip(values).enumerate() {
-            let preset = crate::asset::channel_name(layer.preset.as_deref().unwrap_or("layer"));
+            let preset = preset_label(layer.preset.as_deref());
             out.push(Layer::scalar(format!("layers_{label}_{i}_{preset}"), values));
         }
     }
     out
 }
 
+/// A layer's preset as a channel name: a preset file by its stem (`presets/brass.toml` is
+/// `brass`), a library preset by its name, and `layer` for a layer without one.
+fn preset_label(preset: Option<&str>) -> String {
+    let name = match preset {
+        Some(file) if file.ends_with(".toml") => {
+            std::path::Path::new(file).file_stem().and_then(|s| s.to_str()).unwrap_or(file)
+        }
+        Some(name) => name,
+        None => "layer",
+    };
+    crate::asset::channel_name(name)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn layers_are_named_by_their_presets() {
+        assert_eq!(preset_label(Some("gold")), "gold");
+        assert_eq!(preset_label(Some("presets/material_004.toml")), "material_004");
+        assert_eq!(preset_label(Some("../looks/Rusty Metal.toml")), "Rusty_Metal");
+        assert_eq!(preset_label(None), "layer");
+    }
 
     #[test]
     fn names_and_groups_parse() {
