@@ -105,12 +105,15 @@ fn layer_list(
                 actions.push(Action::Select(Selection { object: Some(object), layer: Some(index) }));
             }
         });
+        // The pointer's half of the row says where the layer goes: above the row or below it.
+        let rect = row.response.rect;
+        let above = ui.ctx().pointer_interact_pos().is_none_or(|p| p.y < rect.center().y);
         if let Some(from) = row.response.dnd_release_payload::<usize>() {
-            dropped = Some((*from, index));
+            dropped = Some((*from, drop_index(*from, index, above)));
         }
         if row.response.dnd_hover_payload::<usize>().is_some() {
-            let rect = row.response.rect;
-            ui.painter().hline(rect.x_range(), rect.top(), egui::Stroke::new(2.0, ui.visuals().selection.bg_fill));
+            let y = if above { rect.top() } else { rect.bottom() };
+            ui.painter().hline(rect.x_range(), y, egui::Stroke::new(2.0, ui.visuals().selection.bg_fill));
         }
     }
     if let Some((from, to)) = dropped.filter(|(from, to)| from != to) {
@@ -118,6 +121,20 @@ fn layer_list(
         actions.push(Action::Select(Selection { object: Some(object), layer: Some(to) }));
     }
     add
+}
+
+/// Where layer `from` ends up (for [`Edit::MoveLayer`], which removes it, then inserts it)
+/// when dropped just above (`above`) or just below the layer `onto`. The list shows the top
+/// layer first, so above a row is a higher index.
+fn drop_index(from: usize, onto: usize, above: bool) -> usize {
+    // The gap it goes into, counted in the stack before the move: gap g lies below layer g.
+    let gap = if above { onto + 1 } else { onto };
+    // Taking the layer out first shifts every gap above it down by one.
+    if from < gap {
+        gap - 1
+    } else {
+        gap
+    }
 }
 
 /// "gold · stripes (inverted) · 60% · 2 maps".
@@ -311,4 +328,38 @@ fn override_dot(ui: &mut egui::Ui, overridden: bool) -> egui::Response {
         ui.painter().circle_stroke(rect.center(), 3.5, egui::Stroke::new(1.0, Color32::from_gray(110)));
     }
     response
+}
+
+#[cfg(test)]
+mod tests {
+    use super::drop_index;
+
+    /// Dropped above or below any layer, dragging up or down, a layer lands next to it, on the
+    /// side the drop line showed, and the others keep their order.
+    #[test]
+    fn a_dropped_layer_lands_where_the_line_shows() {
+        let count = 4;
+        for from in 0..count {
+            for onto in (0..count).filter(|&onto| onto != from) {
+                for above in [true, false] {
+                    let mut stack: Vec<usize> = (0..count).collect();
+                    let moved = stack.remove(from);
+                    stack.insert(drop_index(from, onto, above), moved);
+                    let at = |layer: usize| stack.iter().position(|&l| l == layer).unwrap();
+                    let expected = if above { at(onto) + 1 } else { at(onto) - 1 };
+                    let side = if above { "above" } else { "below" };
+                    assert_eq!(at(from), expected, "layer {from} dropped {side} layer {onto}: {stack:?}");
+                    let others: Vec<usize> = stack.iter().copied().filter(|&l| l != from).collect();
+                    assert!(others.windows(2).all(|w| w[0] < w[1]), "{stack:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_layer_dropped_next_to_itself_stays() {
+        // Just above the layer below it, or just below the layer above it: no move.
+        assert_eq!(drop_index(2, 1, true), 2);
+        assert_eq!(drop_index(2, 3, false), 2);
+    }
 }
