@@ -436,6 +436,53 @@ fn a_click_inspects_the_pixel_and_selects_its_object() {
     assert_eq!(default.layers[0].params.get(Param::Sheen), Value::Scalar(0.0), "the default stack is untouched");
 }
 
+/// The inspector follows the image: an edit and its undo change the blended material it shows,
+/// and its radiance keeps up with the accumulation rather than staying at the pick's.
+#[test]
+fn the_inspector_follows_edits_undo_and_accumulation() {
+    let Some(case) = Case::new() else { return };
+    let gbuffer = GBuffer::read(&case.path("g.exr")).unwrap();
+    let stripes = &gbuffer.masks["stripes"];
+    let ball = (0..gbuffer.pixel_count())
+        .filter(|&i| gbuffer.object_id[i] == 1 && gbuffer.coverage[i] == 1.0)
+        .min_by(|&a, &b| (stripes[a] - 0.5).abs().total_cmp(&(stripes[b] - 0.5).abs()))
+        .unwrap();
+    let xy = format!("{} {}", ball as u32 % SIZE, ball as u32 / SIZE);
+    case.write(
+        "inspect.script",
+        &format!("wait-spp 1\npick {xy}\ninspect\nset roughness 0.9\ninspect\nundo\ninspect\nwait-spp 4\ninspect\n"),
+    );
+    let output = case.view(&["look.toml", "--script", "inspect.script", "--exit-after-spp", "4"]);
+    assert_success(&output);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let lines: Vec<&str> = stdout.lines().filter(|l| l.starts_with("lookdev: pixel")).collect();
+    assert_eq!(lines.len(), 5, "{stdout}");
+    let roughness = |line: &str| -> f32 {
+        line.split(" roughness=").nth(1).and_then(|v| v.split(' ').next()).unwrap().parse().unwrap()
+    };
+    let (picked, edited, undone, converged) = (lines[1], lines[2], lines[3], lines[4]);
+    assert!(roughness(edited) > roughness(picked) + 0.1, "the edit shows:\n{picked}\n{edited}");
+    assert_eq!(roughness(undone), roughness(picked), "the undo shows:\n{picked}\n{undone}");
+
+    // Converged, the inspector shows the 4-spp radiance that `lookdev render` gives.
+    assert!(converged.ends_with("at 4 spp"), "{converged}");
+    let radiance: Vec<f32> = converged
+        .split("radiance ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let args = ["render", "--gbuffer", "g.exr", "--look", "look.toml", "--spp", "4", "--quiet", "--out", "r.exr"];
+    assert_success(&case.command(&args).output().unwrap());
+    let rendered = read_exr_pixel(&case.path("r.exr"), ball);
+    assert!(rendered[0] > 0.0);
+    for c in 0..3 {
+        assert!((radiance[c] - rendered[c]).abs() <= 1e-5 * rendered[c].abs().max(1.0), "{radiance:?} vs {rendered:?}");
+    }
+}
+
 fn read_exr_pixel(path: &Path, index: usize) -> [f32; 3] {
     use exr::prelude::{read_first_rgba_layer_from_file, RgbaChannels};
     let image = read_first_rgba_layer_from_file(

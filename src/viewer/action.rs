@@ -32,6 +32,9 @@ pub enum Action {
         x: u32,
         y: u32,
     },
+    /// Prints what the inspector shows now (a script's `inspect`), which follows edits, undo
+    /// and accumulation.
+    ShowInspection,
     /// Loads an environment (`None`: the built-in studio) and makes it the look's.
     OpenEnvironment(Option<PathBuf>),
     /// Opens another look (asks first when there are unsaved edits).

@@ -334,7 +334,8 @@ impl Running {
     /// Carries out an action. A failure from the panels is shown in the status bar; one from a
     /// script line stops the viewer, naming the line.
     fn perform(&mut self, origin: Origin, action: Action) -> Result<()> {
-        let scripted_pick = matches!((origin, &action), (Origin::Script(_), Action::Pick { .. }));
+        let scripted_pick =
+            matches!((origin, &action), (Origin::Script(_), Action::Pick { .. } | Action::ShowInspection));
         let outcome = self.try_perform(action);
         if let (true, Ok(_), Some(pixel)) = (scripted_pick, &outcome, &self.session.inspection) {
             println!("lookdev: {pixel}");
@@ -405,6 +406,11 @@ impl Running {
                     let document = &mut self.session.document;
                     let top = document.stack(object).map(|s| s.layers.len().saturating_sub(1));
                     document.select(Selection { object: Some(object), layer: top });
+                }
+            }
+            Action::ShowInspection => {
+                if self.session.inspection.is_none() {
+                    return Err(Error::input("no pixel is picked: 'pick X Y' first"));
                 }
             }
             Action::OpenEnvironment(path) => {

@@ -61,7 +61,7 @@ impl LayerChange {
 
 /// The commands, for the error that names an unknown one.
 const COMMANDS: &str = "select, set, reset, map, add, remove, duplicate, move, show, hide, mask, invert, opacity, \
-    rotate, intensity, background, env, exposure, tonemap, spp, seed, undo, redo, pick, wait-spp, save-look, \
+    rotate, intensity, background, env, exposure, tonemap, spp, seed, undo, redo, pick, inspect, wait-spp, save-look, \
     save-preset, save-image, screenshot, open-look, quit, answer, compare, divider";
 
 impl Script {
@@ -237,6 +237,10 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
         "pick" => {
             arity(2)?;
             Ok(Step::Do(Action::Pick { x: number(args[0], "x")?, y: number(args[1], "y")? }))
+        }
+        "inspect" => {
+            arity(0)?;
+            Ok(Step::Do(Action::ShowInspection))
         }
         "wait-spp" => {
             arity(1)?;

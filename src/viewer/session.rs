@@ -357,7 +357,8 @@ impl Session {
     fn apply_changes(&mut self, everything: bool) -> Result<()> {
         let settings = self.document.settings().clone();
         let mut restarted = false;
-        if everything || self.document.material_revision() != self.shown.material_revision {
+        let material_changed = everything || self.document.material_revision() != self.shown.material_revision;
+        if material_changed {
             let packed = PackedStacks::pack(
                 self.document.look(),
                 self.objects.iter().copied(),
@@ -409,6 +410,10 @@ impl Session {
             self.changed_at = Instant::now();
             self.first_pass_after_change = None;
         }
+        if restarted || material_changed {
+            // The layer names and weights may change with no change to what is rendered.
+            self.refresh_inspection()?;
+        }
         if everything || (settings.exposure, settings.tonemap) != (self.shown.exposure, self.shown.tonemap) {
             self.shown.exposure = settings.exposure;
             self.shown.tonemap = settings.tonemap;
@@ -433,7 +438,22 @@ impl Session {
         if self.first_pass_after_change.is_none() && self.samples() > 0 {
             self.first_pass_after_change = Some(self.changed_at.elapsed());
         }
+        // The inspector's radiance follows the accumulation, read back at 1, 2, 4, … samples
+        // and at the target rather than every frame.
+        let samples = self.samples();
+        let behind = self.inspection.as_ref().is_some_and(|i| i.samples != samples);
+        if behind && (samples.is_power_of_two() || samples >= target) {
+            self.refresh_inspection()?;
+        }
         Ok(stepped)
+    }
+
+    /// Inspects the picked pixel again, after an edit, an undo or more samples.
+    fn refresh_inspection(&mut self) -> Result<()> {
+        if let Some(Inspection { x, y, .. }) = self.inspection {
+            self.inspect(x, y)?;
+        }
+        Ok(())
     }
 
     /// Brings every row to the same sample count (rows may be a band apart mid-pass), so that
