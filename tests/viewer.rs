@@ -483,6 +483,30 @@ fn the_inspector_follows_edits_undo_and_accumulation() {
     }
 }
 
+/// The panels keep their width whatever their values' widths: a four- and five-digit emission
+/// neither widens the layer panel nor moves or rescales the image.
+#[test]
+fn wide_values_move_neither_the_panels_nor_the_image() {
+    let Some(case) = Case::new() else { return };
+    let gbuffer = GBuffer::read(&case.path("g.exr")).unwrap();
+    let ball = (0..gbuffer.pixel_count()).find(|&i| gbuffer.object_id[i] == 1 && gbuffer.coverage[i] == 1.0).unwrap();
+    let xy = format!("{} {}", ball as u32 % SIZE, ball as u32 / SIZE);
+    case.write(
+        "wide.script",
+        &format!(
+            "wait-spp 1\npick {xy}\nscreenshot narrow.png\nset emission 12345.5,6789.25,1000.125\nwait-spp 1\nscreenshot wide.png\n"
+        ),
+    );
+    let output = case.view(&["look.toml", "--script", "wide.script", "--exit-after-spp", "1"]);
+    assert_success(&output);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let placement = |name: &str| -> String {
+        let line = stdout.lines().find(|l| l.starts_with("lookdev: screenshot") && l.contains(name)).unwrap();
+        line.split("the image is at ").nth(1).expect("the placement is reported").to_string()
+    };
+    assert_eq!(placement("narrow.png"), placement("wide.png"), "{stdout}");
+}
+
 fn read_exr_pixel(path: &Path, index: usize) -> [f32; 3] {
     use exr::prelude::{read_first_rgba_layer_from_file, RgbaChannels};
     let image = read_first_rgba_layer_from_file(

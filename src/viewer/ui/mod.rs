@@ -84,8 +84,11 @@ impl Interface {
         self.shortcuts(ui.ctx(), frame, actions);
         egui::Panel::top("menu").show(ui, |ui| self.menu(ui, frame, actions));
         egui::Panel::bottom("status").show(ui, |ui| self.status(ui, frame));
+        // Each side panel scrolls what does not fit, both ways, rather than growing with its
+        // content: a wide value must not move the image.
+        let scrolled = || egui::ScrollArea::both().auto_shrink([false, false]);
         egui::Panel::left("stack").default_size(340.0).show(ui, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| {
+            scrolled().show(ui, |ui| {
                 let open_browser = layers::show(ui, frame.session, actions);
                 if open_browser {
                     self.browser.open = true;
@@ -93,7 +96,7 @@ impl Interface {
             })
         });
         egui::Panel::right("light").default_size(300.0).show(ui, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| {
+            scrolled().show(ui, |ui| {
                 lighting::show(ui, frame.session, &mut self.file_dialog, actions);
                 ui.separator();
                 compare::show(ui, frame.session, &mut self.file_dialog, actions);
