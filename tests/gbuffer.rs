@@ -874,6 +874,40 @@ fn shaderball_directions_are_unit_and_tangents_orthogonal() {
     }
 }
 
+/// The pedestal is cylinders and their flat caps, so every normal below the ball is horizontal
+/// (a side) or vertical (a cap). A pixel where two surfaces meet (the crease of the neck and the
+/// foot's top, the neck's silhouette against the foot) takes one surface's normal: an average
+/// of the two is a surface that is not there, and at 1024² it lit a bright one-pixel seam along
+/// row 910 and specks at (368–370, 887–889).
+#[test]
+fn shaderball_pedestal_normals_are_its_surfaces_even_at_creases() {
+    for size in [SIZE, 1024] {
+        let g = GBuffer::shaderball(size, size);
+        let width = size as usize;
+        // Rows from the first one without the ball down: only the pedestal and background.
+        let first = (0..width)
+            .rev()
+            .find(|&y| g.object_id[y * width..(y + 1) * width].contains(&lookdev::gbuffer::BALL_ID))
+            .unwrap()
+            + 1;
+        let mut bad = Vec::new();
+        for i in first * width..g.pixel_count() {
+            let n = g.normal[i];
+            let side = n[1].abs() < 1e-4;
+            let cap = (n[1].abs() - 1.0).abs() < 1e-4;
+            if g.coverage[i] > 0.0 && !side && !cap {
+                bad.push((i % width, i / width, n));
+            }
+        }
+        assert!(
+            bad.is_empty(),
+            "{size}²: {} pedestal normals between surfaces, e.g. {:?}",
+            bad.len(),
+            &bad[..bad.len().min(4)]
+        );
+    }
+}
+
 #[test]
 fn shaderball_masks_are_bounded_and_non_trivial() {
     let g = shaderball();

@@ -364,6 +364,28 @@ fn renders_are_deterministic() {
     common::gpu::finish(ctx);
 }
 
+/// Every image the passes write, and every display image, starts cleared: what an earlier image
+/// left in the same memory is never read back, or shown by the viewer before its first pass.
+#[test]
+fn new_images_start_cleared_not_with_what_freed_memory_held() {
+    use lookdev::gpu::Image;
+    let ctx = common::gpu::context();
+    let float =
+        |ctx: &lookdev::gpu::Context| Image::new(ctx, ash::vk::Format::R32G32B32A32_SFLOAT, 16, 16, 1, false).unwrap();
+    for round in 0..8 {
+        // Leave a pattern in memory the allocator is likely to hand out again.
+        for stale in [float(&ctx), Image::display(&ctx, 32, 32).unwrap()] {
+            stale.upload(&ctx, &vec![0x5a; stale.byte_size() as usize]).unwrap();
+        }
+        for fresh in [float(&ctx), Image::display(&ctx, 32, 32).unwrap()] {
+            let bytes = fresh.read(&ctx).unwrap();
+            let stale = bytes.iter().filter(|&&b| b != 0).count();
+            assert_eq!(stale, 0, "round {round}: {stale} of {} bytes of a new image are not zero", bytes.len());
+        }
+    }
+    common::gpu::finish(ctx);
+}
+
 #[test]
 fn layered_look_from_toml_renders_masks_where_they_are() {
     // Left half gold, right half rubber: the two halves of the sphere must differ in colour.

@@ -745,6 +745,24 @@ fn the_split_view_shows_a_beside_another_model_and_each_half_matches_lookdev_ren
     assert_halves(&case.screenshot_image(&output, "s.png"), column, &b, &a);
 }
 
+/// Right after a split starts, B has not finished a pass: B's half shows A's own pixels (never
+/// B's image before its first pass, which held whatever its memory held), and A's half is A.
+#[test]
+fn until_b_finishes_a_pass_its_half_of_the_split_shows_a() {
+    let Some(case) = Case::new() else { return };
+    let a = case.render("look.toml", 2, "a.png");
+    case.write("early.script", "wait-spp 2\ncompare model diffuse=lambert\nscreenshot early.png\n");
+    let output = case.view(&["look.toml", "--script", "early.script", "--exit-after-spp", "2"]);
+    assert_success(&output);
+    let (column, labels) = split_of(&output, "early.png").expect("the split is reported");
+    assert!(labels.contains("B: diffuse=lambert"), "{labels}");
+    let shot = case.screenshot_image(&output, "early.png");
+    let left = 0..column - DIVIDER_MARGIN;
+    let right = column + DIVIDER_MARGIN..SIZE;
+    assert_matches_render(&region(&shot, left.clone()), &region(&a, left));
+    assert_matches_render(&region(&shot, right.clone()), &region(&a, right));
+}
+
 #[test]
 fn the_split_view_shows_a_beside_another_look_under_the_same_light() {
     let Some(case) = Case::new() else { return };

@@ -15,8 +15,10 @@ pub(crate) const PEDESTAL_NAME: &str = "pedestal";
 
 const BALL_RADIUS: f32 = 1.0;
 /// The neck's top (y = -0.8) is inside the ball, so ball and pedestal meet without a gap.
-const NECK: Cylinder = Cylinder { radius: 0.42, bottom: -1.06, top: -0.8 };
-const FOOT: Cylinder = Cylinder { radius: 0.7, bottom: -1.2, top: -1.06 };
+const NECK: Cylinder = Cylinder { radius: 0.42, bottom: -1.06, top: -0.8, surfaces: [1, 2, 3] };
+const FOOT: Cylinder = Cylinder { radius: 0.7, bottom: -1.2, top: -1.06, surfaces: [4, 5, 6] };
+/// Surfaces of the scene, numbered 0 (the ball) to SURFACES - 1 (see [`Hit::surface`]).
+pub(crate) const SURFACES: usize = 7;
 /// A sphere (centre, radius) that encloses the neck and the foot: the foot's rim (0.7, -1.2) is
 /// 0.728 from (0, -1, 0), the neck's top rim (0.42, -0.8) 0.465.
 const PEDESTAL_BOUNDS: (Vec3, f32) = (Vec3::new(0.0, -1.0, 0.0), 0.75);
@@ -43,14 +45,20 @@ pub(crate) struct Hit {
     /// Unit outward normal.
     pub normal: Vec3,
     pub object_id: u32,
+    /// Which smooth piece of the scene was hit, below [`SURFACES`]: 0 the ball, then each
+    /// cylinder's side, top and bottom cap. Normals vary smoothly within a surface and jump
+    /// between two, where they meet in a crease or one is seen past the other's silhouette.
+    pub surface: u32,
 }
 
-/// A closed cylinder around the +Y axis.
+/// A closed cylinder around the +Y axis. `surfaces` numbers its side, top and bottom caps
+/// (see [`Hit::surface`]).
 #[derive(Clone, Copy)]
 struct Cylinder {
     radius: f32,
     bottom: f32,
     top: f32,
+    surfaces: [u32; 3],
 }
 
 /// The nearest hit of the ray `origin + t·direction` (unit direction) with the scene.
@@ -103,13 +111,14 @@ fn hit_ball(origin: Vec3, direction: Vec3) -> Option<Hit> {
     let root = discriminant.sqrt();
     let distance = [-b - root, -b + root].into_iter().find(|&t| t > MIN_DISTANCE)?;
     let position = origin + direction * distance;
-    Some(Hit { distance, position, normal: position.normalize(), object_id: BALL_ID })
+    Some(Hit { distance, position, normal: position.normalize(), object_id: BALL_ID, surface: 0 })
 }
 
 fn hit_cylinder(cylinder: &Cylinder, origin: Vec3, direction: Vec3) -> Option<Hit> {
     let side = hit_cylinder_side(cylinder, origin, direction);
-    let top = hit_cap(cylinder, cylinder.top, Vec3::Y, origin, direction);
-    let bottom = hit_cap(cylinder, cylinder.bottom, -Vec3::Y, origin, direction);
+    let [_, top_surface, bottom_surface] = cylinder.surfaces;
+    let top = hit_cap(cylinder, (cylinder.top, Vec3::Y, top_surface), origin, direction);
+    let bottom = hit_cap(cylinder, (cylinder.bottom, -Vec3::Y, bottom_surface), origin, direction);
     nearest(nearest(side, top), bottom)
 }
 
@@ -131,20 +140,20 @@ fn hit_cylinder_side(cylinder: &Cylinder, origin: Vec3, direction: Vec3) -> Opti
         let within = (cylinder.bottom..=cylinder.top).contains(&position.y);
         (distance > MIN_DISTANCE && within).then(|| {
             let normal = Vec3::new(position.x, 0.0, position.z).normalize();
-            Hit { distance, position, normal, object_id: PEDESTAL_ID }
+            Hit { distance, position, normal, object_id: PEDESTAL_ID, surface: cylinder.surfaces[0] }
         })
     })
 }
 
-/// A flat cap at height `y`, facing `normal` (±Y).
-fn hit_cap(cylinder: &Cylinder, y: f32, normal: Vec3, origin: Vec3, direction: Vec3) -> Option<Hit> {
+/// A flat cap at height `y`, facing `normal` (±Y), numbered `surface`.
+fn hit_cap(cylinder: &Cylinder, (y, normal, surface): (f32, Vec3, u32), origin: Vec3, direction: Vec3) -> Option<Hit> {
     if direction.y.abs() < 1e-12 {
         return None;
     }
     let distance = (y - origin.y) / direction.y;
     let position = origin + direction * distance;
     let inside = position.x * position.x + position.z * position.z <= cylinder.radius * cylinder.radius;
-    (distance > MIN_DISTANCE && inside).then_some(Hit { distance, position, normal, object_id: PEDESTAL_ID })
+    (distance > MIN_DISTANCE && inside).then_some(Hit { distance, position, normal, object_id: PEDESTAL_ID, surface })
 }
 
 #[cfg(test)]

@@ -2,9 +2,12 @@
 //!
 //! Each pixel is sampled on a regular 4×4 grid (regular, not jittered, so the output is
 //! deterministic and identical on every machine). Coverage is the fraction of subsamples that hit;
-//! normals, tangents and view vectors are averaged over the hits and renormalised; the object ID
-//! is the one most hits saw. Masks are filtered over the pixel's footprint on the surface (see
-//! `pixel_masks` and `procedural`).
+//! view vectors are averaged over the hits and renormalised; the object ID is the one most hits
+//! saw. The normal and tangent are averaged over the hits on one surface only, the one of that
+//! object that most hits saw: where two surfaces meet in a pixel (a crease, or a silhouette
+//! against another surface), an average of their normals faces a way neither does, and its
+//! reflection shows light that neither surface sees. Masks are filtered over the pixel's
+//! footprint on the surface (see `pixel_masks` and `procedural`).
 
 use std::collections::BTreeMap;
 
@@ -14,6 +17,7 @@ use super::frame::tangent_or_stable;
 use super::procedural::{masks_at, Footprint, MASK_NAMES};
 use super::scene::{
     around_axis, trace, Hit, BALL_ID, BALL_NAME, CAMERA_DISTANCE, FIELD_OF_VIEW_DEGREES, PEDESTAL_ID, PEDESTAL_NAME,
+    SURFACES,
 };
 use super::GBuffer;
 
@@ -153,8 +157,6 @@ fn render(camera: &Camera) -> Vec<Pixel> {
 struct ObjectTally {
     hits: usize,
     position: Vec3,
-    normal: Vec3,
-    tangent: Vec3,
     view: Vec3,
     lowest: Vec3,
     highest: Vec3,
@@ -165,12 +167,30 @@ impl Default for ObjectTally {
         ObjectTally {
             hits: 0,
             position: Vec3::ZERO,
-            normal: Vec3::ZERO,
-            tangent: Vec3::ZERO,
             view: Vec3::ZERO,
             lowest: Vec3::INFINITY,
             highest: Vec3::NEG_INFINITY,
         }
+    }
+}
+
+/// Sums over the subsamples of one pixel that hit one surface (see [`Hit::surface`]).
+#[derive(Clone, Copy, Default)]
+struct SurfaceTally {
+    hits: usize,
+    object_id: u32,
+    normal: Vec3,
+    /// Summed unnormalised: within a pixel the lengths barely differ, and the sum is made unit
+    /// and orthogonal to the pixel's normal at the end.
+    tangent: Vec3,
+}
+
+impl SurfaceTally {
+    fn add(&mut self, hit: &Hit) {
+        self.hits += 1;
+        self.object_id = hit.object_id;
+        self.normal += hit.normal;
+        self.tangent += around_axis(hit.position);
     }
 }
 
@@ -180,10 +200,6 @@ impl ObjectTally {
     fn add(&mut self, hit: &Hit, view: Vec3) {
         self.hits += 1;
         self.position += hit.position;
-        self.normal += hit.normal;
-        // Summed unnormalised: within a pixel the lengths barely differ, and the sum is made
-        // unit and orthogonal to the pixel's normal at the end.
-        self.tangent += around_axis(hit.position);
         self.view += view;
         self.lowest = self.lowest.min(hit.position);
         self.highest = self.highest.max(hit.position);
@@ -199,13 +215,17 @@ impl ObjectTally {
 fn shade_pixel(camera: &Camera, x: usize, y: usize) -> Pixel {
     let mut hits = [None; SUBSAMPLES];
     let mut tallies = [ObjectTally::default(); OBJECT_IDS.len()];
+    let mut surfaces = [SurfaceTally::default(); SURFACES];
     let mut background_view = Vec3::ZERO;
     for (s, hit) in hits.iter_mut().enumerate() {
         let offset = |s: usize| (s as f32 + 0.5) / GRID as f32;
         let direction = camera.ray(x as f32 + offset(s % GRID), y as f32 + offset(s / GRID));
         *hit = trace(camera.eye, direction);
         match hit {
-            Some(hit) => tallies[slot(hit.object_id)].add(hit, -direction),
+            Some(hit) => {
+                tallies[slot(hit.object_id)].add(hit, -direction);
+                surfaces[hit.surface as usize].add(hit);
+            }
             None => background_view -= direction,
         }
     }
@@ -215,14 +235,15 @@ fn shade_pixel(camera: &Camera, x: usize, y: usize) -> Pixel {
         let view = background_view.normalize();
         return Pixel { view, ..Pixel::default() };
     }
-    let sum = |field: fn(&ObjectTally) -> Vec3| tallies.iter().map(field).sum::<Vec3>();
-    let normal = sum(|t| t.normal).normalize_or(Vec3::Z);
+    let object_id = majority_object(&tallies);
+    let surface = main_surface(&surfaces, object_id);
+    let normal = surface.normal.normalize_or(Vec3::Z);
     Pixel {
         normal,
-        view: sum(|t| t.view).normalize_or(Vec3::Z),
-        tangent: tangent_or_stable(normal, sum(|t| t.tangent)),
+        view: tallies.iter().map(|t| t.view).sum::<Vec3>().normalize_or(Vec3::Z),
+        tangent: tangent_or_stable(normal, surface.tangent),
         coverage: hit_count as f32 / SUBSAMPLES as f32,
-        object_id: majority_object(&tallies),
+        object_id,
         masks: pixel_masks(camera, &tallies, &hits, hit_count),
     }
 }
@@ -241,6 +262,17 @@ fn majority_object(tallies: &[ObjectTally; OBJECT_IDS.len()]) -> u32 {
         }
     }
     best.0
+}
+
+/// The surface of `object_id` with the most hits; on a tie, the lower-numbered one.
+fn main_surface(surfaces: &[SurfaceTally; SURFACES], object_id: u32) -> SurfaceTally {
+    let mut best = SurfaceTally::default();
+    for surface in surfaces.iter().filter(|s| s.object_id == object_id) {
+        if surface.hits > best.hits {
+            best = *surface;
+        }
+    }
+    best
 }
 
 /// Masks averaged over the objects in the pixel, weighted by hits.

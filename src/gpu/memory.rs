@@ -172,6 +172,12 @@ impl Purpose {
         }
     }
 
+    /// Whether a new image is cleared: all but textures (filled at once) and depth buffers
+    /// (cleared by their render pass).
+    fn cleared_on_creation(self) -> bool {
+        matches!(self, Purpose::Storage | Purpose::Display | Purpose::ColorTarget)
+    }
+
     fn aspect(self) -> vk::ImageAspectFlags {
         match self {
             Purpose::DepthTarget => vk::ImageAspectFlags::DEPTH,
@@ -329,6 +335,12 @@ impl Image {
         }
         ctx.run(|cmd| {
             result.transition_to_general(cmd);
+            // New memory holds whatever was there before (on a CPU driver, often an image just
+            // freed): an image that kernels write or the viewer shows starts as zeros, so no
+            // read and no frame ever sees that. Textures are filled right after.
+            if purpose.cleared_on_creation() {
+                result.record_clear(cmd);
+            }
             Ok(())
         })?;
         Ok(result)

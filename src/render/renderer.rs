@@ -52,6 +52,9 @@ pub struct Renderer {
     seed: u32,
     /// Samples each row has in the current accumulation.
     row_samples: Vec<u32>,
+    /// Whether every row has had a pass since this renderer was made: until then, its display
+    /// image holds rows it has not drawn (cleared when made, but not a picture of anything).
+    passed: bool,
 }
 
 impl Renderer {
@@ -84,6 +87,7 @@ impl Renderer {
             lighting: Lighting::default(),
             seed: 0,
             row_samples: vec![0; height as usize],
+            passed: false,
         })
     }
 
@@ -131,6 +135,12 @@ impl Renderer {
     /// Samples every pixel has accumulated since the last change.
     pub fn samples(&self) -> u32 {
         self.row_samples.iter().copied().min().unwrap_or(0)
+    }
+
+    /// Whether every row has been rendered at least once since the renderer was made (restarts
+    /// do not undo it): then its display image shows a whole picture, if not the latest one.
+    pub fn has_finished_a_pass(&self) -> bool {
+        self.passed
     }
 
     /// Samples row `row` has in the current accumulation.
@@ -218,6 +228,7 @@ impl Renderer {
             self.row_samples[start as usize..run_end as usize].iter_mut().for_each(|n| *n += count);
             start = run_end;
         }
+        self.passed |= self.samples() > 0;
         Ok(total)
     }
 

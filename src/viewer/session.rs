@@ -218,6 +218,12 @@ impl Session {
         self.compare.as_ref().map(|b| b.renderer.display_image())
     }
 
+    /// Whether B's image is ready to be shown: B has finished its first pass. Until then, B's
+    /// half of the split shows A.
+    pub fn compare_ready(&self) -> bool {
+        self.compare.as_ref().is_some_and(|b| b.renderer.has_finished_a_pass())
+    }
+
     /// What B is, when comparing.
     pub fn compare_subject(&self) -> Option<&Subject> {
         self.compare.as_ref().map(|b| &b.subject)
@@ -267,7 +273,6 @@ impl Session {
     }
 
     fn start_compare(&mut self, subject: Subject, packed: PackedStacks) -> Result<()> {
-        let settings = self.document.settings().clone();
         let environment = self
             .environments
             .iter()
@@ -278,7 +283,8 @@ impl Session {
         renderer.set_stacks(&packed)?;
         renderer.set_lighting(self.shown.lighting);
         renderer.set_seed(self.shown.seed);
-        renderer.finalize_rows(0, self.height(), settings.exposure, settings.tonemap)?;
+        // Its display image starts cleared and is not shown until its first pass has landed
+        // (see `compare_ready`).
         let mut progressive = Progressive::new();
         progressive.set_budget(FRAME_BUDGET / 2);
         self.progressive.set_budget(FRAME_BUDGET / 2);

@@ -84,6 +84,8 @@ impl Viewport {
                 let a_rect = Rect::from_min_max(image_rect.min, pos2(x, image_rect.max.y));
                 let b_rect = Rect::from_min_max(pos2(x, image_rect.min.y), image_rect.max);
                 painter.image(texture, a_rect, Rect::from_min_max(pos2(0.0, 0.0), pos2(u, 1.0)), Color32::WHITE);
+                // Until B has finished a pass, its image is not a picture yet: show A there.
+                let b = if session.compare_ready() { b } else { texture };
                 painter.image(b, b_rect, Rect::from_min_max(pos2(u, 0.0), pos2(1.0, 1.0)), Color32::WHITE);
             }
         }
