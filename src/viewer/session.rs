@@ -180,6 +180,11 @@ impl Session {
         self.target_override = Some(spp);
     }
 
+    /// `--exit-after-spp`'s sample count, when it stands in for the document's target.
+    pub fn target_override(&self) -> Option<u32> {
+        self.target_override
+    }
+
     /// The shaded object ids, ascending.
     pub fn objects(&self) -> &[u32] {
         &self.objects
