@@ -326,6 +326,23 @@ fn bindings_the_gbuffer_cannot_satisfy_stop_the_script_at_their_line() {
     }
 }
 
+/// `select` of an object the g-buffer lacks stops the script at that line, naming the objects
+/// there are, rather than leaving nothing selected for the next line to trip over.
+#[test]
+fn selecting_an_object_the_gbuffer_lacks_stops_the_script_at_its_line() {
+    let Some(case) = Case::new() else { return };
+    case.write("select.script", "select 1 0\n\nselect 7\nset roughness 0.5\n");
+    let output = case.view(&["look.toml", "--script", "select.script"]);
+    assert_eq!(output.status.code(), Some(2), "{}", stderr(&output));
+    let text = stderr(&output);
+    assert!(
+        text.contains("select.script:3: object 7 is not in the g-buffer g.exr (it has: 1 'ball', 2 'pedestal')"),
+        "{text}"
+    );
+    assert!(!text.contains("panicked") && !text.contains("no layer is selected"), "{text}");
+    assert_eq!(text.trim_end().lines().count(), 1, "one line: {text}");
+}
+
 #[test]
 fn rotating_the_light_changes_the_image_and_leaves_the_materials_alone() {
     let Some(case) = Case::new() else { return };

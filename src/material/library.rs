@@ -254,6 +254,71 @@ pub enum Origin {
     Builtin,
 }
 
+/// Why a preset matched a search (docs/commands.md#lookdev-view-looktoml---gbuffer-file---env-file---device-name).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum MatchedBy {
+    /// The name is the query, starts with it or contains it.
+    Name,
+    /// This tag is the query or contains it.
+    Tag(String),
+    /// Only the description contains the query.
+    Description,
+}
+
+impl std::fmt::Display for MatchedBy {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            MatchedBy::Name => write!(f, "name"),
+            MatchedBy::Tag(tag) => write!(f, "tag: {tag}"),
+            MatchedBy::Description => write!(f, "in description"),
+        }
+    }
+}
+
+/// How well a preset (its name, tags and description) matches `query`, case-insensitively:
+/// a rank (lower is better) and why; `None` when it does not match. The ranks: the name is the
+/// query, the name starts with it, the name contains it, a tag is the query, a tag contains it,
+/// the description contains it.
+pub fn search_match(query: &str, name: &str, tags: &[String], description: &str) -> Option<(u8, MatchedBy)> {
+    let query = query.trim().to_lowercase();
+    let name = name.to_lowercase();
+    if query.is_empty() || name == query {
+        return Some((0, MatchedBy::Name));
+    }
+    if name.starts_with(&query) {
+        return Some((1, MatchedBy::Name));
+    }
+    if name.contains(&query) {
+        return Some((2, MatchedBy::Name));
+    }
+    if let Some(tag) = tags.iter().find(|t| t.to_lowercase() == query) {
+        return Some((3, MatchedBy::Tag(tag.clone())));
+    }
+    if let Some(tag) = tags.iter().find(|t| t.to_lowercase().contains(&query)) {
+        return Some((4, MatchedBy::Tag(tag.clone())));
+    }
+    description.to_lowercase().contains(&query).then_some((5, MatchedBy::Description))
+}
+
+/// The presets among `items` that match `query`, best first (see [`search_match`]), in their
+/// given order within a rank, each with why it matched. `fields` gives an item's name, tags and
+/// description. An empty query matches everything, by name.
+pub fn search<'a, T>(
+    items: &'a [T],
+    query: &str,
+    fields: impl Fn(&T) -> (&str, &[String], &str),
+) -> Vec<(&'a T, MatchedBy)> {
+    let mut found: Vec<(u8, &T, MatchedBy)> = items
+        .iter()
+        .filter_map(|item| {
+            let (name, tags, description) = fields(item);
+            search_match(query, name, tags, description).map(|(rank, why)| (rank, item, why))
+        })
+        .collect();
+    found.sort_by_key(|(rank, _, _)| *rank);
+    found.into_iter().map(|(_, item, why)| (item, why)).collect()
+}
+
 /// The stems of the `*.toml` files in a folder, sorted; an unreadable folder has none.
 fn toml_stems(dir: &Path) -> Vec<String> {
     // A look given as a bare file name has the empty path as its folder.
@@ -284,6 +349,75 @@ mod tests {
 
     fn presets_folder() -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("presets")
+    }
+
+    /// The built-in presets as the browser lists them.
+    fn builtins() -> Vec<Preset> {
+        builtin_names().into_iter().map(|name| builtin(name).unwrap()).collect()
+    }
+
+    fn fields(p: &Preset) -> (&str, &[String], &str) {
+        (&p.name, &p.tags, &p.description)
+    }
+
+    #[test]
+    fn search_ranks_names_then_tags_then_descriptions_and_says_why() {
+        let presets = builtins();
+        let found = search(&presets, "rough", fields);
+        // Every description mentions roughness, so everything matches; the tagged ones lead.
+        assert_eq!(found.len(), presets.len());
+        let tagged: BTreeSet<&str> =
+            presets.iter().filter(|p| p.tags.iter().any(|t| t == "rough")).map(|p| p.name.as_str()).collect();
+        assert!(!tagged.is_empty());
+        let first: BTreeSet<&str> = found[..tagged.len()].iter().map(|(p, _)| p.name.as_str()).collect();
+        assert_eq!(first, tagged, "the presets tagged rough come first");
+        for (preset, why) in &found {
+            if tagged.contains(preset.name.as_str()) {
+                assert_eq!(*why, MatchedBy::Tag("rough".into()), "{}", preset.name);
+            } else {
+                assert_eq!(*why, MatchedBy::Description, "{}", preset.name);
+                assert!(preset.description.to_lowercase().contains("rough"), "{}", preset.name);
+            }
+        }
+        assert_eq!(MatchedBy::Tag("rough".into()).to_string(), "tag: rough");
+        assert_eq!(MatchedBy::Description.to_string(), "in description");
+
+        // The exact name, then names that start with the query, then names that contain it,
+        // then tags.
+        let found = search(&presets, "Aluminium", fields);
+        let names: Vec<&str> = found.iter().map(|(p, _)| p.name.as_str()).collect();
+        assert_eq!(names[..2], ["aluminium", "brushed-aluminium"]);
+        assert!(found[..2].iter().all(|(_, why)| *why == MatchedBy::Name));
+        let found = search(&presets, "metal", fields);
+        let tag_at = found.iter().position(|(_, why)| matches!(why, MatchedBy::Tag(_))).unwrap();
+        assert!(found[..tag_at].iter().all(|(_, why)| *why == MatchedBy::Name), "{found:?}");
+        assert!(found[tag_at..].iter().all(|(_, why)| *why != MatchedBy::Name), "{found:?}");
+        let description_at = found.iter().position(|(_, why)| *why == MatchedBy::Description);
+        if let Some(at) = description_at {
+            assert!(found[at..].iter().all(|(_, why)| *why == MatchedBy::Description), "{found:?}");
+        }
+    }
+
+    #[test]
+    fn search_finds_words_only_descriptions_use() {
+        let presets = builtins();
+        // A word from a description that no name or tag has.
+        let word = presets
+            .iter()
+            .flat_map(|p| p.description.split(|c: char| !c.is_alphabetic()))
+            .filter(|w| w.len() > 4)
+            .map(str::to_lowercase)
+            .find(|w| {
+                presets.iter().all(|p| !p.name.contains(w.as_str()) && p.tags.iter().all(|t| !t.contains(w.as_str())))
+            })
+            .expect("some description has a word of its own");
+        let found = search(&presets, &word, fields);
+        assert!(!found.is_empty(), "{word}");
+        assert!(found
+            .iter()
+            .all(|(p, why)| *why == MatchedBy::Description && p.description.to_lowercase().contains(&word)));
+        assert!(search(&presets, "no-preset-says-this", fields).is_empty());
+        assert_eq!(search(&presets, "", fields).len(), presets.len(), "an empty query lists everything");
     }
 
     #[test]

@@ -368,7 +368,12 @@ impl Running {
                     return Ok(Some("nothing to redo".into()));
                 }
             }
-            Action::Select(selection) => document.select(selection),
+            Action::Select(selection) => {
+                if let Some(object) = selection.object {
+                    self.session.check_object(object)?;
+                }
+                self.session.document.select(selection);
+            }
             Action::AddPresetLayer(preset) => {
                 let object = document.selection().object.unwrap_or(ObjectRef::Default);
                 document.apply(Edit::AddLayer { object, preset: preset.clone() }).map_err(Error::input)?;

@@ -180,9 +180,33 @@ impl Session {
         self.target_override = Some(spp);
     }
 
+    /// `--exit-after-spp`'s sample count, when it stands in for the document's target.
+    pub fn target_override(&self) -> Option<u32> {
+        self.target_override
+    }
+
     /// The shaded object ids, ascending.
     pub fn objects(&self) -> &[u32] {
         &self.objects
+    }
+
+    /// Refuses an object id the g-buffer does not shade, naming the objects it does: selecting
+    /// one would leave no stack and no layer to edit.
+    pub fn check_object(&self, object: ObjectRef) -> Result<()> {
+        let ObjectRef::Id(id) = object else { return Ok(()) };
+        if self.objects.contains(&id) {
+            return Ok(());
+        }
+        let has: Vec<String> = self
+            .objects
+            .iter()
+            .map(|id| match self.gbuffer.object_names.get(id) {
+                Some(name) => format!("{id} '{name}'"),
+                None => id.to_string(),
+            })
+            .collect();
+        let has = if has.is_empty() { "no objects".to_string() } else { format!("it has: {}", has.join(", ")) };
+        Err(Error::input(format!("object {id} is not in the g-buffer {} ({has})", self.gbuffer_name.display())))
     }
 
     /// The g-buffer's mask names.

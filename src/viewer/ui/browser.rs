@@ -1,11 +1,12 @@
 //! The preset library browser: every preset the look can name, as thumbnails on the ball, with
-//! search and a tag filter. A click adds the preset as a new layer on top of the selected stack.
+//! search and a tag filter. Search lists name matches first, then tag matches, then presets
+//! only the description matches, each with why it matched. A click adds the preset as a new layer on top of the selected stack.
 
 use super::super::action::Action;
 use super::super::session::Session;
 use super::super::thumbnails::{self, Thumbnails};
 use super::Message;
-use crate::material::library::Origin;
+use crate::material::library::{self, MatchedBy, Origin};
 use crate::material::Params;
 use egui::RichText;
 use std::collections::{BTreeSet, HashMap};
@@ -102,17 +103,17 @@ impl Browser {
             });
             ui.label(RichText::new(format!("Click a preset to add it as a layer on top of {target}.")).weak());
             ui.separator();
-            let search = self.search.to_lowercase();
-            let shown: Vec<&Entry> = entries
-                .iter()
-                .filter(|e| self.tag.as_ref().is_none_or(|t| e.tags.contains(t)))
-                .filter(|e| {
-                    search.is_empty()
-                        || e.name.to_lowercase().contains(&search)
-                        || e.description.to_lowercase().contains(&search)
-                        || e.tags.iter().any(|t| t.to_lowercase().contains(&search))
-                })
-                .collect();
+            // Best first: names, then tags, then descriptions, each saying why it matched.
+            let tagged: Vec<&Entry> =
+                entries.iter().filter(|e| self.tag.as_ref().is_none_or(|t| e.tags.contains(t))).collect();
+            let shown: Vec<(&Entry, Option<MatchedBy>)> = if self.search.trim().is_empty() {
+                tagged.into_iter().map(|e| (e, None)).collect()
+            } else {
+                library::search(&tagged, &self.search, |e| (&e.name, &e.tags, &e.description))
+                    .into_iter()
+                    .map(|(e, why)| (*e, Some(why)))
+                    .collect()
+            };
             // One new thumbnail per frame, so the interface stays live while they render.
             let mut may_render = true;
             egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
@@ -121,11 +122,11 @@ impl Browser {
                 let columns = ((ui.available_width() / cell_width) as usize).max(1);
                 for row in shown.chunks(columns) {
                     ui.horizontal(|ui| {
-                        for entry in row {
+                        for (entry, why) in row {
                             let texture = entry.params.as_ref().and_then(|params| {
                                 texture(ctx, &mut self.textures, thumbnails, params, &mut may_render, message)
                             });
-                            if cell(ui, entry, texture) {
+                            if cell(ui, entry, why.as_ref(), texture) {
                                 actions.push(Action::AddPresetLayer(entry.name.clone()));
                             }
                         }
@@ -174,7 +175,7 @@ fn texture(
 }
 
 /// One preset's cell; true when clicked.
-fn cell(ui: &mut egui::Ui, entry: &Entry, texture: Option<egui::TextureId>) -> bool {
+fn cell(ui: &mut egui::Ui, entry: &Entry, why: Option<&MatchedBy>, texture: Option<egui::TextureId>) -> bool {
     let size = egui::vec2(thumbnails::SIZE as f32, thumbnails::SIZE as f32);
     let response = ui
         .vertical(|ui| {
@@ -198,6 +199,9 @@ fn cell(ui: &mut egui::Ui, entry: &Entry, texture: Option<egui::TextureId>) -> b
                 name = name.italics();
             }
             ui.label(name);
+            if let Some(why) = why {
+                ui.label(RichText::new(why.to_string()).small().weak());
+            }
         })
         .response
         .interact(egui::Sense::click());

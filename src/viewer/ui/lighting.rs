@@ -76,13 +76,23 @@ pub fn show(ui: &mut egui::Ui, session: &Session, file_dialog: &mut Option<FileD
         });
         ui.end_row();
         ui.label("Target spp");
-        let mut spp = settings.spp;
-        if ui
-            .add(egui::DragValue::new(&mut spp).range(1..=1_000_000))
-            .on_hover_text("Accumulation stops here")
-            .changed()
-        {
-            actions.push(Action::Drag(Edit::SetTargetSpp(spp)));
+        // The target the session renders to, as the progress bar counts it: with
+        // --exit-after-spp that, and not the look's, which it leaves alone.
+        let mut spp = session.target();
+        match session.target_override() {
+            Some(_) => {
+                ui.add_enabled(false, egui::DragValue::new(&mut spp))
+                    .on_disabled_hover_text(format!("Set by --exit-after-spp (the look's target is {})", settings.spp));
+            }
+            None => {
+                if ui
+                    .add(egui::DragValue::new(&mut spp).range(1..=1_000_000))
+                    .on_hover_text("Accumulation stops here")
+                    .changed()
+                {
+                    actions.push(Action::Drag(Edit::SetTargetSpp(spp)));
+                }
+            }
         }
         ui.end_row();
         ui.label("Seed");
@@ -94,4 +104,59 @@ pub fn show(ui: &mut egui::Ui, session: &Session, file_dialog: &mut Option<FileD
     });
     let progress = session.samples() as f32 / session.target().max(1) as f32;
     ui.add(egui::ProgressBar::new(progress.min(1.0)).text(format!("{} / {} spp", session.samples(), session.target())));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::{Context, ContextOptions};
+    use crate::render::scene::{Scene, SceneSpec};
+    use crate::viewer_state::Document;
+
+    /// Every piece of text the panel draws.
+    fn texts(shape: &egui::Shape, out: &mut Vec<String>) {
+        match shape {
+            egui::Shape::Text(text) => out.push(text.galley.text().to_string()),
+            egui::Shape::Vec(shapes) => shapes.iter().for_each(|s| texts(s, out)),
+            _ => {}
+        }
+    }
+
+    /// The panel's text, drawn once in a headless egui context.
+    fn panel_text(session: &Session) -> Vec<String> {
+        let ctx = egui::Context::default();
+        let mut actions = Vec::new();
+        let mut out = Vec::new();
+        for _ in 0..2 {
+            // The second pass lays out with the sizes the first measured.
+            let output = ctx.run_ui(egui::RawInput::default(), |ui| show(ui, session, &mut None, &mut actions));
+            out.clear();
+            output.shapes.iter().for_each(|clipped| texts(&clipped.shape, &mut out));
+        }
+        out
+    }
+
+    #[test]
+    fn the_target_spp_shown_is_the_one_the_session_renders_to() {
+        let ctx = Context::new(&ContextOptions::from_env(std::env::var("LOOKDEV_TEST_DEVICE").ok())).unwrap();
+        let scene = Scene::load(&SceneSpec::default()).unwrap();
+        let document = Document::new(scene.look.clone(), None, scene.settings.clone());
+        let look_target = document.settings().spp;
+        assert_ne!(look_target, 16, "the look's own target differs from the override");
+        let mut session =
+            Session::new(&ctx, scene.gbuffer, scene.gbuffer_name, document, scene.environment, Default::default())
+                .unwrap();
+        let text = panel_text(&session);
+        assert!(text.contains(&look_target.to_string()), "{text:?}");
+
+        // --exit-after-spp 16: the panel's field and its bar both say 16, the look keeps its own.
+        session.override_target(16);
+        let text = panel_text(&session);
+        assert!(text.contains(&"16".to_string()), "the target field shows 16: {text:?}");
+        assert!(text.contains(&"0 / 16 spp".to_string()), "{text:?}");
+        assert!(!text.contains(&look_target.to_string()), "the look's target is not shown as the target: {text:?}");
+        assert_eq!(session.document.settings().spp, look_target);
+        drop(session);
+        drop(ctx);
+    }
 }
