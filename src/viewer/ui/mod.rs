@@ -87,7 +87,7 @@ impl Interface {
         // Each side panel scrolls what does not fit, both ways, rather than growing with its
         // content: a wide value must not move the image.
         let scrolled = || egui::ScrollArea::both().auto_shrink([false, false]);
-        egui::Panel::left("stack").default_size(340.0).show(ui, |ui| {
+        egui::Panel::left("stack").default_size(400.0).show(ui, |ui| {
             scrolled().show(ui, |ui| {
                 let open_browser = layers::show(ui, frame.session, actions);
                 if open_browser {
