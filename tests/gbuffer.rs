@@ -908,6 +908,24 @@ fn shaderball_pedestal_normals_are_its_surfaces_even_at_creases() {
     }
 }
 
+/// The default look turns the pedestal from ceramic to copper through `gradient`: the mask
+/// must rise over the pedestal itself (it was 0.02–0.14 there when it ran over the whole
+/// scene), and over the ball.
+#[test]
+fn shaderball_gradient_spans_each_object() {
+    let g = shaderball();
+    let gradient = &g.masks["gradient"];
+    for (object, name) in [(1, "ball"), (2, "pedestal")] {
+        let values: Vec<f32> = (0..g.pixel_count())
+            .filter(|&i| g.object_id[i] == object && g.coverage[i] == 1.0)
+            .map(|i| gradient[i])
+            .collect();
+        let low = values.iter().copied().fold(f32::MAX, f32::min);
+        let high = values.iter().copied().fold(f32::MIN, f32::max);
+        assert!(low < 0.2 && high > 0.8, "{name}: gradient {low}..{high}");
+    }
+}
+
 #[test]
 fn shaderball_masks_are_bounded_and_non_trivial() {
     let g = shaderball();

@@ -6,8 +6,6 @@
 
 use glam::Vec3;
 
-use super::scene::{SCENE_BOTTOM, SCENE_TOP};
-
 /// The mask names, in the order [`masks_at`] returns them.
 pub(crate) const MASK_NAMES: [&str; 3] = ["stripes", "grunge", "gradient"];
 
@@ -31,11 +29,12 @@ pub(crate) struct Footprint {
     pub extent: Vec3,
 }
 
-/// All masks at world position `p`, filtered over `footprint`. Each mask uses the extent that
-/// matters to it: the stripes and the gradient vary along Y only, the noise in every direction.
-pub(crate) fn masks_at(p: Vec3, footprint: Footprint) -> [f32; 3] {
+/// All masks at world position `p` on an object spanning `height_span` in Y, filtered over
+/// `footprint`. Each mask uses the extent that matters to it: the stripes vary along Y only,
+/// the noise in every direction.
+pub(crate) fn masks_at(p: Vec3, footprint: Footprint, height_span: (f32, f32)) -> [f32; 3] {
     let extent = footprint.extent;
-    [stripes(p.y, extent.y), grunge(p, extent.max_element()), gradient(p.y)]
+    [stripes(p.y, extent.y), grunge(p, extent.max_element()), gradient(p.y, height_span)]
 }
 
 /// Latitude bands: a square wave in y, box-filtered over the footprint (widened by a little
@@ -84,9 +83,9 @@ fn grunge(p: Vec3, filter_width: f32) -> f32 {
     smoothstep(centre - half_width, centre + half_width, fbm)
 }
 
-/// A vertical ramp in world Y: 0 at the foot of the pedestal, 1 at the top of the ball.
-fn gradient(y: f32) -> f32 {
-    ((y - SCENE_BOTTOM) / (SCENE_TOP - SCENE_BOTTOM)).clamp(0.0, 1.0)
+/// A vertical ramp in world Y over an object: 0 at its lowest point, 1 at its highest.
+fn gradient(y: f32, (bottom, top): (f32, f32)) -> f32 {
+    ((y - bottom) / (top - bottom)).clamp(0.0, 1.0)
 }
 
 fn smoothstep(edge0: f32, edge1: f32, x: f32) -> f32 {

@@ -23,9 +23,18 @@ pub(crate) const SURFACES: usize = 7;
 /// 0.728 from (0, -1, 0), the neck's top rim (0.42, -0.8) 0.465.
 const PEDESTAL_BOUNDS: (Vec3, f32) = (Vec3::new(0.0, -1.0, 0.0), 0.75);
 
-/// The lowest and highest points of the scene, for the world-space gradient mask.
-pub(crate) const SCENE_BOTTOM: f32 = FOOT.bottom;
-pub(crate) const SCENE_TOP: f32 = BALL_RADIUS;
+/// The lowest and highest visible points of an object, over which its `gradient` mask rises from 0
+/// to 1: each object gets the whole ramp, so a layer through it shows on the pedestal as well
+/// as on the ball.
+pub(crate) fn height_span(object_id: u32) -> (f32, f32) {
+    if object_id == BALL_ID {
+        (-BALL_RADIUS, BALL_RADIUS)
+    } else {
+        // The pedestal's highest visible point: where the neck enters the ball.
+        let neck_meets_ball = -(BALL_RADIUS * BALL_RADIUS - NECK.radius * NECK.radius).sqrt();
+        (FOOT.bottom, neck_meets_ball)
+    }
+}
 
 /// Vertical field of view of the camera.
 pub(crate) const FIELD_OF_VIEW_DEGREES: f32 = 30.0;

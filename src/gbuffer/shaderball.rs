@@ -16,8 +16,8 @@ use glam::Vec3;
 use super::frame::tangent_or_stable;
 use super::procedural::{masks_at, Footprint, MASK_NAMES};
 use super::scene::{
-    around_axis, trace, Hit, BALL_ID, BALL_NAME, CAMERA_DISTANCE, FIELD_OF_VIEW_DEGREES, PEDESTAL_ID, PEDESTAL_NAME,
-    SURFACES,
+    around_axis, height_span, trace, Hit, BALL_ID, BALL_NAME, CAMERA_DISTANCE, FIELD_OF_VIEW_DEGREES, PEDESTAL_ID,
+    PEDESTAL_NAME, SURFACES,
 };
 use super::GBuffer;
 
@@ -40,7 +40,8 @@ impl GBuffer {
     ///   y = −1.2) under the ball.
     /// - Tangents run around the +Y axis (the ball's latitude circles).
     /// - Masks, all functions of world position: `stripes` (latitude bands every 0.36 in Y),
-    ///   `grunge` (thresholded fBm value noise), `gradient` (0 at the foot, 1 at the top).
+    ///   `grunge` (thresholded fBm value noise), `gradient` (0 at each object's lowest point, 1
+    ///   at its highest).
     /// - Background pixels: coverage 0, object 0, V = −(camera ray), so the renderer can show the
     ///   environment behind the objects.
     ///
@@ -295,12 +296,13 @@ fn pixel_masks(
         // A pixel with a single hit has no spread to measure, so never go below head-on size.
         let head_on = camera.eye.distance(centroid) * camera.pixel_angle();
         let extent = tally.extent().max(Vec3::splat(head_on));
+        let span = height_span(object_id);
         let object_masks = if extent.max_element() <= STRETCHED * head_on {
-            masks_at(centroid, Footprint { extent })
+            masks_at(centroid, Footprint { extent }, span)
         } else {
             let per_hit = Footprint { extent: (extent / GRID as f32).max(Vec3::splat(head_on / GRID as f32)) };
             let own_hits = hits.iter().flatten().filter(|hit| hit.object_id == object_id);
-            let total = own_hits.fold([0.0; 3], |sum, hit| add(sum, masks_at(hit.position, per_hit)));
+            let total = own_hits.fold([0.0; 3], |sum, hit| add(sum, masks_at(hit.position, per_hit, span)));
             total.map(|m| m / tally.hits as f32)
         };
         let weight = tally.hits as f32 / hit_count as f32;
