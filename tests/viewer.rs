@@ -390,11 +390,7 @@ fn a_click_inspects_the_pixel_and_selects_its_object() {
     // As the viewer reads it: masks are stored as half floats.
     let gbuffer = GBuffer::read(&case.path("g.exr")).unwrap();
     let stripes = &gbuffer.masks["stripes"];
-    // A ball pixel inside the image, half in a stripe, so the gold layer's weight is telling.
-    let ball = (0..gbuffer.pixel_count())
-        .filter(|&i| gbuffer.object_id[i] == 1 && gbuffer.coverage[i] == 1.0)
-        .min_by(|&a, &b| (stripes[a] - 0.5).abs().total_cmp(&(stripes[b] - 0.5).abs()))
-        .unwrap();
+    let ball = half_striped_ball_pixel(&gbuffer);
     let pedestal =
         (0..gbuffer.pixel_count()).find(|&i| gbuffer.object_id[i] == 2 && gbuffer.coverage[i] == 1.0).unwrap();
     let xy = |i: usize| format!("{} {}", i as u32 % SIZE, i as u32 / SIZE);
@@ -427,21 +423,7 @@ fn a_click_inspects_the_pixel_and_selects_its_object() {
     let expected = layers[0].params.metallic * (1.0 - m) + layers[1].params.metallic * m;
     let metallic: f32 = line.split(" metallic=").nth(1).and_then(|v| v.split(' ').next()).unwrap().parse().unwrap();
     assert!((metallic - expected).abs() < 1e-6, "the blended material: {line}");
-    let radiance: Vec<f32> = line
-        .split("radiance ")
-        .nth(1)
-        .and_then(|r| r.split(' ').next())
-        .unwrap()
-        .split(',')
-        .map(|v| v.parse().unwrap())
-        .collect();
-    assert!(line.ends_with("at 4 spp"), "{line}");
-    let args = ["render", "--gbuffer", "g.exr", "--look", "look.toml", "--spp", "4", "--quiet", "--out", "r.exr"];
-    assert_success(&case.command(&args).output().unwrap());
-    let rendered = read_exr_pixel(&case.path("r.exr"), ball);
-    for c in 0..3 {
-        assert!((radiance[c] - rendered[c]).abs() <= 1e-5 * rendered[c].abs().max(1.0), "{radiance:?} vs {rendered:?}");
-    }
+    assert_radiance_is_rendered(&case, line, ball);
 
     // Each click selected the object under it: the ball's top layer got the roughness, and the
     // pedestal, which used the default stack, got a stack of its own with the sheen.
@@ -459,11 +441,7 @@ fn a_click_inspects_the_pixel_and_selects_its_object() {
 fn the_inspector_follows_edits_undo_and_accumulation() {
     let Some(case) = Case::new() else { return };
     let gbuffer = GBuffer::read(&case.path("g.exr")).unwrap();
-    let stripes = &gbuffer.masks["stripes"];
-    let ball = (0..gbuffer.pixel_count())
-        .filter(|&i| gbuffer.object_id[i] == 1 && gbuffer.coverage[i] == 1.0)
-        .min_by(|&a, &b| (stripes[a] - 0.5).abs().total_cmp(&(stripes[b] - 0.5).abs()))
-        .unwrap();
+    let ball = half_striped_ball_pixel(&gbuffer);
     let xy = format!("{} {}", ball as u32 % SIZE, ball as u32 / SIZE);
     case.write(
         "inspect.script",
@@ -482,22 +460,7 @@ fn the_inspector_follows_edits_undo_and_accumulation() {
     assert_eq!(roughness(undone), roughness(picked), "the undo shows:\n{picked}\n{undone}");
 
     // Converged, the inspector shows the 4-spp radiance that `lookdev render` gives.
-    assert!(converged.ends_with("at 4 spp"), "{converged}");
-    let radiance: Vec<f32> = converged
-        .split("radiance ")
-        .nth(1)
-        .and_then(|r| r.split(' ').next())
-        .unwrap()
-        .split(',')
-        .map(|v| v.parse().unwrap())
-        .collect();
-    let args = ["render", "--gbuffer", "g.exr", "--look", "look.toml", "--spp", "4", "--quiet", "--out", "r.exr"];
-    assert_success(&case.command(&args).output().unwrap());
-    let rendered = read_exr_pixel(&case.path("r.exr"), ball);
-    assert!(rendered[0] > 0.0);
-    for c in 0..3 {
-        assert!((radiance[c] - rendered[c]).abs() <= 1e-5 * rendered[c].abs().max(1.0), "{radiance:?} vs {rendered:?}");
-    }
+    assert_radiance_is_rendered(&case, converged, ball);
 }
 
 /// The panels keep their width whatever their values' widths: a four- and five-digit emission
@@ -522,6 +485,36 @@ fn wide_values_move_neither_the_panels_nor_the_image() {
         line.split("the image is at ").nth(1).expect("the placement is reported").to_string()
     };
     assert_eq!(placement("narrow.png"), placement("wide.png"), "{stdout}");
+}
+
+/// A ball pixel inside the image, half in a stripe, so the gold layer's weight is telling.
+fn half_striped_ball_pixel(gbuffer: &GBuffer) -> usize {
+    let stripes = &gbuffer.masks["stripes"];
+    (0..gbuffer.pixel_count())
+        .filter(|&i| gbuffer.object_id[i] == 1 && gbuffer.coverage[i] == 1.0)
+        .min_by(|&a, &b| (stripes[a] - 0.5).abs().total_cmp(&(stripes[b] - 0.5).abs()))
+        .unwrap()
+}
+
+/// An inspector line at 4 spp shows the radiance `lookdev render` gives `pixel` of the case's
+/// look at 4 spp.
+fn assert_radiance_is_rendered(case: &Case, line: &str, pixel: usize) {
+    assert!(line.ends_with("at 4 spp"), "{line}");
+    let radiance: Vec<f32> = line
+        .split("radiance ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let args = ["render", "--gbuffer", "g.exr", "--look", "look.toml", "--spp", "4", "--quiet", "--out", "r.exr"];
+    assert_success(&case.command(&args).output().unwrap());
+    let rendered = read_exr_pixel(&case.path("r.exr"), pixel);
+    assert!(rendered[0] > 0.0, "a lit pixel");
+    for c in 0..3 {
+        assert!((radiance[c] - rendered[c]).abs() <= 1e-5 * rendered[c].abs().max(1.0), "{radiance:?} vs {rendered:?}");
+    }
 }
 
 fn read_exr_pixel(path: &Path, index: usize) -> [f32; 3] {
