@@ -19,6 +19,10 @@ pub struct ViewArgs {
     /// The window's size in logical pixels.
     #[arg(long, num_args = 2, value_names = ["W", "H"])]
     pub window_size: Option<Vec<u32>>,
+    /// The zoom the image opens at: `fit` (the default; magnifies a small image) or window pixels
+    /// per image pixel (`1` for 1:1).
+    #[arg(long, value_name = "fit|SCALE")]
+    pub zoom: Option<String>,
     /// Save the window as a PNG once --exit-after-spp is reached.
     #[arg(long, value_name = "FILE.png", requires = "exit_after_spp")]
     pub screenshot: Option<PathBuf>,
@@ -55,6 +59,10 @@ pub fn run(args: ViewArgs) -> Result<()> {
             return Err(Error::input(format!("--window-size {size:?}: the window must be 320x240 to 16384x16384")));
         }
     };
+    #[cfg(feature = "viewer")]
+    if let Some(zoom) = &args.zoom {
+        crate::viewer::zoom(zoom).map_err(|problem| Error::input(format!("--zoom: {problem}")))?;
+    }
     let mut model = crate::shading::model::Model::default();
     for key in &args.compare_model {
         model.set_from_flag("--compare-model", key).map_err(Error::input)?;
@@ -75,6 +83,7 @@ fn open(args: ViewArgs, scene: crate::render::scene::SceneSpec, window_size: (u3
         scene,
         device: args.device,
         window_size,
+        zoom: args.zoom.as_deref().map(crate::viewer::zoom).transpose().map_err(Error::input)?.flatten(),
         screenshot: args.screenshot,
         exit_after_spp: args.exit_after_spp,
         script,

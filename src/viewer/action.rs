@@ -60,6 +60,11 @@ pub enum Action {
     Compare(Compare),
     /// Moves the split's divider: a fraction of the image's width, from the left.
     Divider(f32),
+    /// A key press, as if typed on the keyboard (a script's `key`): reaches the interface's
+    /// shortcuts in the next frame, so a scripted test drives the real hotkeys.
+    Key(egui::Key, egui::Modifiers),
+    /// Sets the zoom: `None` fits the image to the view, else window pixels per image pixel.
+    Zoom(Option<f32>),
 }
 
 /// What to show as B, beside the edited look (A).

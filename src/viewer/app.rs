@@ -198,7 +198,7 @@ impl Running {
             session,
             ctx,
             window,
-            interface: Interface::default(),
+            interface: Interface::with_zoom(options.zoom),
             script: options.script.clone().map(ScriptRunner::new),
             queue: Vec::new(),
             pending: None,
@@ -463,6 +463,8 @@ impl Running {
                 }
                 self.session.divider = at;
             }
+            Action::Key(key, modifiers) => self.gui.press_key(key, modifiers),
+            Action::Zoom(scale) => self.interface.viewport.zoom_to(scale),
             Action::Answer(answer) => {
                 let pending = self.pending.take().ok_or_else(|| Error::input("there is no question to answer"))?;
                 match answer {

@@ -16,6 +16,8 @@ pub struct Gui {
     renderer: Renderer<egui_ash_renderer::allocator::DefaultAllocator>,
     /// The rendered views: A's, and B's while comparing.
     view_textures: [Option<ViewTexture>; 2],
+    /// Key presses a script made, for the next frame's input.
+    pressed_keys: Vec<egui::Event>,
 }
 
 /// The rendered view as a texture egui can draw: a sampler set over the display image.
@@ -47,7 +49,7 @@ impl Gui {
             Options { in_flight_frames: 1, srgb_framebuffer: true, ..Options::default() },
         )
         .map_err(renderer_error)?;
-        Ok(Gui { ctx: ctx.clone(), egui, state, renderer, view_textures: [None, None] })
+        Ok(Gui { ctx: ctx.clone(), egui, state, renderer, view_textures: [None, None], pressed_keys: Vec::new() })
     }
 
     /// Passes a window event to egui; true when egui used it.
@@ -112,9 +114,17 @@ impl Gui {
         }
     }
 
+    /// Queues a key press (and its release) for the next frame's input, as if typed.
+    pub fn press_key(&mut self, key: egui::Key, modifiers: egui::Modifiers) {
+        for pressed in [true, false] {
+            self.pressed_keys.push(egui::Event::Key { key, physical_key: None, pressed, repeat: false, modifiers });
+        }
+    }
+
     /// Runs the interface for one frame: input in, shapes out, nothing drawn yet.
     pub fn run(&mut self, window: &Window, ui: impl FnMut(&mut egui::Ui)) -> egui::FullOutput {
-        let input = self.state.take_egui_input(window);
+        let mut input = self.state.take_egui_input(window);
+        input.events.append(&mut self.pressed_keys);
         let output = self.egui.run_ui(input, ui);
         self.state.handle_platform_output(window, output.platform_output.clone());
         output

@@ -20,7 +20,7 @@ pub mod thumbnails;
 mod ui;
 
 pub use action::Action;
-pub use script::{Script, Step};
+pub use script::{zoom, Script, Step};
 
 use crate::render::scene::SceneSpec;
 use crate::{Error, Result};
@@ -34,6 +34,9 @@ pub struct ViewOptions {
     pub device: Option<String>,
     /// The window's inner size in logical pixels.
     pub window_size: (u32, u32),
+    /// The zoom the image opens at: `None` fits it to the view, else window pixels per image
+    /// pixel.
+    pub zoom: Option<f32>,
     /// Render to this many samples per pixel, save the window as a PNG and exit.
     pub screenshot: Option<PathBuf>,
     pub exit_after_spp: Option<u32>,

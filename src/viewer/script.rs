@@ -62,7 +62,7 @@ impl LayerChange {
 /// The commands, for the error that names an unknown one.
 const COMMANDS: &str = "select, set, reset, map, add, remove, duplicate, move, show, hide, mask, invert, opacity, \
     rotate, intensity, background, env, exposure, tonemap, spp, seed, undo, redo, pick, inspect, wait-spp, save-look, \
-    save-preset, save-image, screenshot, open-look, quit, answer, compare, divider";
+    save-preset, save-image, screenshot, open-look, quit, answer, compare, divider, key, zoom";
 
 impl Script {
     pub fn load(path: &Path) -> Result<Script> {
@@ -315,7 +315,55 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
             }
             Ok(Step::Do(Action::Divider(at)))
         }
+        "key" => {
+            arity(1)?;
+            let (key, modifiers) = key_press(args[0])?;
+            Ok(Step::Do(Action::Key(key, modifiers)))
+        }
+        "zoom" => {
+            arity(1)?;
+            Ok(Step::Do(Action::Zoom(zoom(args[0])?)))
+        }
         other => Err(format!("unknown command '{other}' (expected one of: {COMMANDS})")),
+    }
+}
+
+/// `C`, `ArrowRight`, `?`, `shift+C`, `ctrl+Z`: a key as egui names it, after any modifiers.
+fn key_press(text: &str) -> std::result::Result<(egui::Key, egui::Modifiers), String> {
+    let mut modifiers = egui::Modifiers::NONE;
+    let mut parts: Vec<&str> = text.split('+').collect();
+    // `+` itself is a key: `key +` or `key shift++`.
+    if text.ends_with("++") || text == "+" {
+        parts.retain(|p| !p.is_empty());
+        parts.push("+");
+    }
+    let name = parts.pop().unwrap_or_default();
+    for modifier in parts {
+        match modifier.to_ascii_lowercase().as_str() {
+            "shift" => modifiers.shift = true,
+            "ctrl" | "command" | "cmd" => modifiers = modifiers | egui::Modifiers::COMMAND,
+            "alt" => modifiers.alt = true,
+            other => return Err(format!("unknown modifier '{other}' in '{text}' (expected shift, ctrl or alt)")),
+        }
+    }
+    let key = egui::Key::from_name(name).ok_or_else(|| {
+        format!("unknown key '{name}' (keys are named as egui names them: A, Num1, ArrowLeft, Escape, ?, …)")
+    })?;
+    Ok((key, modifiers))
+}
+
+/// `fit`, or a scale in window pixels per image pixel (`1`, `2`, `0.5`).
+pub fn zoom(text: &str) -> std::result::Result<Option<f32>, String> {
+    if text == "fit" {
+        return Ok(None);
+    }
+    match text.parse::<f32>() {
+        Ok(scale) if (super::ui::MIN_SCALE..=super::ui::MAX_SCALE).contains(&scale) => Ok(Some(scale)),
+        _ => Err(format!(
+            "zoom '{text}' is neither 'fit' nor a scale from {} to {}",
+            super::ui::MIN_SCALE,
+            super::ui::MAX_SCALE
+        )),
     }
 }
 
@@ -405,6 +453,28 @@ mod tests {
         assert_eq!(*steps[2], Step::Do(Action::Compare(Compare::Swap)));
         assert_eq!(*steps[3], Step::Do(Action::Compare(Compare::Off)));
         assert_eq!(*steps[4], Step::Do(Action::Divider(0.25)));
+    }
+
+    #[test]
+    fn keys_and_zoom_parse_to_their_actions() {
+        let script = parse("key C\nkey shift+ArrowRight\nkey ?\nkey ctrl+Z\nzoom fit\nzoom 2\n").unwrap();
+        let steps: Vec<&Step> = script.steps.iter().map(|(_, s)| s).collect();
+        let shift = egui::Modifiers::SHIFT;
+        assert_eq!(*steps[0], Step::Do(Action::Key(egui::Key::C, egui::Modifiers::NONE)));
+        assert_eq!(*steps[1], Step::Do(Action::Key(egui::Key::ArrowRight, shift)));
+        assert_eq!(*steps[2], Step::Do(Action::Key(egui::Key::Questionmark, egui::Modifiers::NONE)));
+        assert_eq!(*steps[3], Step::Do(Action::Key(egui::Key::Z, egui::Modifiers::COMMAND)));
+        assert_eq!(*steps[4], Step::Do(Action::Zoom(None)));
+        assert_eq!(*steps[5], Step::Do(Action::Zoom(Some(2.0))));
+        for (line, problem) in [
+            ("key Banana", "unknown key 'Banana'"),
+            ("key super+C", "unknown modifier 'super'"),
+            ("zoom 100", "zoom '100' is neither 'fit' nor a scale"),
+            ("zoom", "'zoom' takes 1 argument"),
+        ] {
+            let message = parse(line).unwrap_err().to_string();
+            assert!(message.contains(problem), "{line}: {message}");
+        }
     }
 
     #[test]

@@ -13,3 +13,4 @@ pub mod reference;
 pub mod reference_render;
 pub mod scenes;
 pub mod stats;
+pub mod viewer;

@@ -14,7 +14,7 @@ mod lighting;
 mod viewport;
 
 pub use dialogs::{FileDialog, FilePurpose};
-pub use viewport::ImagePlacement;
+pub use viewport::{ImagePlacement, MAX_SCALE, MIN_SCALE};
 
 use super::action::Action;
 use super::session::Session;
@@ -69,6 +69,13 @@ pub struct Interface {
 }
 
 impl Interface {
+    /// The interface with the image at `zoom` (`None`: fitted).
+    pub fn with_zoom(zoom: Option<f32>) -> Interface {
+        let mut interface = Interface::default();
+        interface.viewport.zoom_to(zoom);
+        interface
+    }
+
     /// Shows a message in the status bar.
     pub fn tell(&mut self, text: impl Into<String>, error: bool) {
         self.message = Some(Message { text: text.into(), error, since: Instant::now() });

@@ -8,13 +8,13 @@ use egui::{pos2, vec2, Color32, PointerButton, Rect, Sense};
 
 /// Degrees of environment rotation per point dragged: a drag across a typical view is a turn.
 const DEGREES_PER_POINT: f32 = 0.4;
-const MIN_SCALE: f32 = 1.0 / 16.0;
-const MAX_SCALE: f32 = 32.0;
+pub const MIN_SCALE: f32 = 1.0 / 16.0;
+pub const MAX_SCALE: f32 = 32.0;
 
 /// How the image sits in the view.
 #[derive(Default)]
 pub struct Viewport {
-    /// Window pixels per image pixel; `None` fits the image to the view, never beyond 1:1.
+    /// Window pixels per image pixel; `None` fits the image to the view, magnifying a small one.
     scale: Option<f32>,
     /// The image centre's offset from the view centre, in points.
     pan: egui::Vec2,
@@ -45,7 +45,12 @@ impl Viewport {
     }
 
     pub fn actual_pixels(&mut self) {
-        self.scale = Some(1.0);
+        self.zoom_to(Some(1.0));
+    }
+
+    /// Sets the zoom (`None`: fit) about the view's centre.
+    pub fn zoom_to(&mut self, scale: Option<f32>) {
+        self.scale = scale;
         self.pan = egui::Vec2::ZERO;
     }
 
@@ -61,7 +66,9 @@ impl Viewport {
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
         let ppp = ui.ctx().pixels_per_point();
         let (w, h) = (session.width() as f32, session.height() as f32);
-        let fit = (rect.width() * ppp / w).min(rect.height() * ppp / h).min(1.0);
+        // Fit fills the view both ways: a small g-buffer is magnified rather than left a postage
+        // stamp (nearest filtering keeps its pixels sharp).
+        let fit = (rect.width() * ppp / w).min(rect.height() * ppp / h).clamp(MIN_SCALE, MAX_SCALE);
         let scale = self.scale.unwrap_or(fit);
         let size = vec2(w, h) * scale / ppp;
         let centre = rect.center() + self.pan;
