@@ -5,7 +5,7 @@
 use crate::environment::LoadOptions;
 use crate::gbuffer::source::{Channels, SourceOptions, Up};
 use crate::material::{Look, Param, Value};
-use crate::render::scene::{GBufferSpec, LookSource, SceneSpec};
+use crate::render::scene::{GBufferSpec, LookSource, SceneSpec, MAX_BUILTIN_SIDE};
 use crate::render::settings::Overrides;
 use crate::shading::tonemap::Tonemap;
 use crate::{Error, Result};
@@ -26,20 +26,44 @@ pub struct SceneArgs {
     pub sampling: SamplingArgs,
     #[command(flatten)]
     pub display: DisplayArgs,
+    /// The built-in shader ball's size in pixels (default 1024 1024); not with --gbuffer.
+    #[arg(long, num_args = 2, value_names = ["W", "H"])]
+    pub size: Option<Vec<u32>>,
 }
 
 impl SceneArgs {
     /// The scene these flags describe with the look `look` (the default one if `None`) and
     /// the AOVs `aovs`.
     pub fn spec(&self, look: Option<&Path>, aovs: &[String], quiet: bool) -> Result<SceneSpec> {
+        let size = self.builtin_size()?;
         Ok(SceneSpec {
             look: look.map_or(LookSource::Default, |path| LookSource::File(path.to_path_buf())),
-            gbuffer: self.gbuffer.spec()?,
+            gbuffer: GBufferSpec { builtin_size: size, size_given: size.is_some(), ..self.gbuffer.spec()? },
             sets: parse_sets(&self.set)?,
             overrides: Overrides { aovs: aovs.to_vec(), ..overrides(&self.lighting, &self.sampling, &self.display) },
             env_options: self.lighting.load_options(),
             quiet,
         })
+    }
+
+    /// `--size W H`, checked: within [`MAX_BUILTIN_SIDE`], and only for the built-in scene.
+    fn builtin_size(&self) -> Result<Option<(u32, u32)>> {
+        let Some(size) = &self.size else { return Ok(None) };
+        let [width, height] = size[..] else {
+            return Err(Error::input("--size takes a width and a height, e.g. --size 1920 1080"));
+        };
+        if let Some(file) = &self.gbuffer.gbuffer {
+            return Err(Error::input(format!(
+                "--size {width} {height} sizes the built-in shader ball, but --gbuffer {} is rendered at its own size",
+                file.display()
+            )));
+        }
+        if !(1..=MAX_BUILTIN_SIDE).contains(&width) || !(1..=MAX_BUILTIN_SIDE).contains(&height) {
+            return Err(Error::input(format!(
+                "--size {width} {height}: each side must be 1 to {MAX_BUILTIN_SIDE} pixels"
+            )));
+        }
+        Ok(Some((width, height)))
     }
 
     /// Refuses bad flags before anything is read: `--set`, the g-buffer's channel flags, and
@@ -95,7 +119,7 @@ impl GBufferArgs {
             camera_position: self.camera_position,
             channels,
         };
-        Ok(GBufferSpec { file: self.gbuffer.clone(), source, builtin_size: None })
+        Ok(GBufferSpec { file: self.gbuffer.clone(), source, ..GBufferSpec::default() })
     }
 }
 

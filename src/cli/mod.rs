@@ -1,5 +1,5 @@
 //! The command line: `lookdev render | gbuffer | bake | import | presets | wedge | turntable | view | lint | brdf |
-//! bench | devices`.
+//! bench | devices | look`.
 
 mod bake;
 mod bench;
@@ -8,6 +8,7 @@ mod gbuffer;
 mod import;
 mod inputs;
 mod lint;
+mod look;
 mod presets;
 mod progress;
 mod render;
@@ -56,6 +57,8 @@ pub enum Command {
     Bench(bench::BenchArgs),
     /// List the Vulkan devices lookdev can use, best first.
     Devices,
+    /// Looks: `lookdev look default` writes the built-in default look out, to start one from.
+    Look(look::LookArgs),
 }
 
 /// The command line, parsed: a command to run, or text clap prints (help, the version).
@@ -143,6 +146,7 @@ pub fn run(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<()> {
         Command::Brdf(args) => brdf::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Devices => list_devices(),
+        Command::Look(args) => look::run(args),
     }
 }
 

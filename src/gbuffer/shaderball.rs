@@ -33,8 +33,9 @@ const OBJECT_IDS: [u32; 2] = [BALL_ID, PEDESTAL_ID];
 impl GBuffer {
     /// The built-in look-dev scene at `width` × `height` (1024 × 1024 is the usual size).
     ///
-    /// - Camera: eye at (0, 0, 5.5) looking exactly toward −Z, 30° vertical field of view,
-    ///   aspect `width / height`. The image centre is the direction −Z.
+    /// - Camera: eye at (0, 0, 5.5) looking exactly toward −Z, a 30° field of view across the
+    ///   shorter side (vertical for a square or wide image), square pixels. The image centre is
+    ///   the direction −Z.
     /// - Object 1 "ball": a unit sphere at the origin, centred in the frame.
     /// - Object 2 "pedestal": a neck (radius 0.42) on a round foot (radius 0.7, bottom at
     ///   y = −1.2) under the ball.
@@ -85,12 +86,15 @@ struct Camera {
 
 impl Camera {
     fn new(width: u32, height: u32) -> Camera {
+        // The field of view spans the shorter side, so a tall image frames the scene as a
+        // square one does, with more above and below, rather than cropping the ball's sides.
+        let aspect = width as f32 / height as f32;
         Camera {
             width,
             height,
             eye: Vec3::new(0.0, 0.0, CAMERA_DISTANCE),
-            half_height: (FIELD_OF_VIEW_DEGREES.to_radians() * 0.5).tan(),
-            aspect: width as f32 / height as f32,
+            half_height: (FIELD_OF_VIEW_DEGREES.to_radians() * 0.5).tan() / aspect.min(1.0),
+            aspect,
         }
     }
 

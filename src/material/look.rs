@@ -170,6 +170,12 @@ impl PartialEq for Layer {
 const DEFAULT_LOOK: &str = include_str!("default_look.toml");
 
 impl Look {
+    /// The built-in look's file, as written (comments included): what `lookdev look default`
+    /// writes out.
+    pub fn builtin_default_text() -> &'static str {
+        DEFAULT_LOOK
+    }
+
     /// Reads and parses a look file. A missing file is an error naming it.
     pub fn load(path: &Path) -> crate::Result<Look> {
         Look::parse(&input::read_text(path)?, path)

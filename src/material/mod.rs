@@ -3,6 +3,7 @@
 pub mod library;
 pub mod look;
 pub mod params;
+pub mod physical;
 pub mod preset;
 pub mod stack;
 mod toml_input;

@@ -114,6 +114,50 @@ impl Param {
     }
 }
 
+/// A heading the layer panel and the docs group parameters under, as look-dev tools do.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Group {
+    Base,
+    Specular,
+    Coat,
+    Sheen,
+    Subsurface,
+}
+
+/// Every parameter under its group, groups and parameters in the order the panel shows them:
+/// the one place the grouping is written (the UI, the docs and [`Param::group`] read it).
+pub const GROUPS: [(Group, &[Param]); 5] = [
+    (Group::Base, &[Param::BaseColor, Param::Metallic, Param::Roughness, Param::Emission]),
+    (Group::Specular, &[Param::Specular, Param::SpecularTint, Param::Anisotropic]),
+    (Group::Coat, &[Param::Clearcoat, Param::ClearcoatGloss]),
+    (Group::Sheen, &[Param::Sheen, Param::SheenTint]),
+    (Group::Subsurface, &[Param::Subsurface]),
+];
+
+impl Group {
+    pub fn name(self) -> &'static str {
+        match self {
+            Group::Base => "Base",
+            Group::Specular => "Specular",
+            Group::Coat => "Coat",
+            Group::Sheen => "Sheen",
+            Group::Subsurface => "Subsurface",
+        }
+    }
+
+    /// The group's parameters, in panel order.
+    pub fn params(self) -> &'static [Param] {
+        GROUPS.iter().find(|(group, _)| *group == self).map_or(&[], |(_, params)| params)
+    }
+}
+
+impl Param {
+    /// The group the parameter is shown under.
+    pub fn group(self) -> Group {
+        GROUPS.iter().find(|(_, params)| params.contains(&self)).map_or(Group::Base, |(group, _)| *group)
+    }
+}
+
 impl fmt::Display for Param {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
@@ -359,6 +403,21 @@ pub fn parse_value(param: Param, text: &str) -> Result<Value, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The grouping holds each parameter exactly once, so the panel shows every one and none
+    /// twice; a parameter added to [`Param::ALL`] fails here until it has a group.
+    #[test]
+    fn every_parameter_is_in_exactly_one_group() {
+        for param in Param::ALL {
+            let homes: Vec<Group> =
+                GROUPS.iter().filter(|(_, params)| params.contains(&param)).map(|(group, _)| *group).collect();
+            assert_eq!(homes.len(), 1, "{param} is in {homes:?}");
+            assert_eq!(param.group(), homes[0]);
+            assert!(param.group().params().contains(&param));
+        }
+        let listed: usize = GROUPS.iter().map(|(_, params)| params.len()).sum();
+        assert_eq!(listed, Param::ALL.len(), "a group lists a parameter twice");
+    }
 
     #[test]
     fn names_round_trip_and_gpu_layout_is_invertible() {

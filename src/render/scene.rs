@@ -12,6 +12,9 @@ use std::path::{Path, PathBuf};
 
 /// Size of the built-in shader ball when no g-buffer is given.
 pub const BUILTIN_SIZE: u32 = 1024;
+/// The largest side `--size` gives the built-in shader ball: 8192² is a 4 GiB g-buffer, made
+/// on the CPU, and above most devices' image limits.
+pub const MAX_BUILTIN_SIDE: u32 = 8192;
 
 /// What a render's inputs are, as a command or the viewer names them. Every command that
 /// renders and the viewer describe their inputs so, and [`Scene::load`] reads them: one way to
@@ -108,6 +111,9 @@ pub struct GBufferSpec {
     /// The built-in shader ball's size when no file is named ([`BUILTIN_SIZE`] square if
     /// `None`).
     pub builtin_size: Option<(u32, u32)>,
+    /// `builtin_size` came from `--size`: a g-buffer file the look names is then an error, not
+    /// a silent change of size.
+    pub size_given: bool,
 }
 
 /// A look made ready to render with `sets`: with any, it gets a default stack if it has none,
@@ -174,6 +180,13 @@ pub struct ReadGBuffer {
 /// warnings, and gives the look's stacks that name their objects those objects' ids.
 pub fn read_gbuffer(spec: &GBufferSpec, look: &mut Look, quiet: bool) -> Result<ReadGBuffer> {
     let file = spec.file.clone().or_else(|| look.gbuffer.file.clone());
+    if let (true, Some(path), Some((width, height))) = (spec.size_given, &file, spec.builtin_size) {
+        let look_name = look.file.as_deref().map_or("the look".into(), |p| p.display().to_string());
+        return Err(crate::Error::input(format!(
+            "--size {width} {height} sizes the built-in shader ball, but {look_name} names the g-buffer {} ([gbuffer] file)",
+            path.display()
+        )));
+    }
     let (gbuffer, name) = match file {
         Some(path) => {
             let read = GBuffer::read_with(&path, &spec.source.over(&look.gbuffer.source))?;

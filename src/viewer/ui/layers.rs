@@ -4,10 +4,14 @@
 use super::super::action::Action;
 use super::super::session::{layer_label, Session};
 use crate::material::look::{Layer, ObjectStack};
-use crate::material::params::{Param, Value};
+use crate::material::params::{Param, Value, GROUPS};
+use crate::material::physical;
 use crate::material::stack::bindable_maps;
 use crate::viewer_state::{Edit, ObjectRef, Selection};
 use egui::{Color32, RichText};
+
+/// The width of the parameter-name column: "clearcoat_gloss" in the default font, and a margin.
+const NAME_WIDTH: f32 = 110.0;
 
 /// Shows the panel; returns true when the artist asked to add a layer from the library.
 pub fn show(ui: &mut egui::Ui, session: &Session, actions: &mut Vec<Action>) -> bool {
@@ -207,7 +211,6 @@ fn parameters(
     layer: &Layer,
     actions: &mut Vec<Action>,
 ) {
-    let document = &session.document;
     ui.heading("Parameters");
     ui.horizontal(|ui| {
         override_dot(ui, true);
@@ -223,76 +226,113 @@ fn parameters(
                 .weak(),
         );
     }
-    egui::Grid::new("parameters").num_columns(4).spacing([6.0, 4.0]).show(ui, |ui| {
-        for param in Param::ALL {
-            let overridden = document.is_overridden(object, index, param);
-            let preset_value = document.preset_value(object, index, param);
-            override_dot(ui, overridden).on_hover_text(if overridden {
-                format!("Overridden; the preset has {preset_value}")
-            } else {
-                "The preset's value".to_string()
+    // Grouped as look-dev tools group them (material::params::GROUPS); each name's tooltip says
+    // what the value means physically, from the layer's values now.
+    for (group, params) in GROUPS {
+        egui::CollapsingHeader::new(RichText::new(group.name()).strong())
+            .id_salt(("parameter group", group.name()))
+            .default_open(true)
+            .show(ui, |ui| {
+                egui::Grid::new(("parameters", group.name()))
+                    .num_columns(4)
+                    .spacing([6.0, 4.0])
+                    .min_col_width(12.0)
+                    .show(ui, |ui| {
+                        for &param in params {
+                            parameter_row(ui, session, object, index, layer, param, actions);
+                            ui.end_row();
+                        }
+                    });
             });
-            let bound = layer.maps.get(&param);
-            if with_maps {
-                map_choice(ui, session, param, bound, actions);
-            } else {
-                ui.label(param.name());
-            }
-            let value = layer.params.get(param);
-            let mut changed = None;
-            match value {
-                Value::Color(mut rgb) => {
-                    ui.horizontal(|ui| {
-                        // egui's picker works in sRGB and hands back linear values, as stored; it
-                        // holds [0, 1], so emission above 1 is typed into the fields.
-                        if rgb.iter().all(|&c| c <= 1.0)
-                            && egui::widgets::color_picker::color_edit_button_rgb(ui, &mut rgb).changed()
-                        {
-                            changed = Some(Value::Color(rgb));
-                        }
-                        for channel in 0..3 {
-                            let drag = egui::DragValue::new(&mut rgb[channel])
-                                .range(0.0..=param.max())
-                                .speed(0.002)
-                                .max_decimals(4);
-                            if ui.add(drag).on_hover_text("Linear value").changed() {
-                                changed = Some(Value::Color(rgb));
-                            }
-                        }
-                    });
-                }
-                Value::Scalar(mut v) => {
-                    ui.horizontal(|ui| {
-                        // The slider spans the plausible range; the field takes typed values up
-                        // to the format's limit.
-                        let slider = egui::Slider::new(&mut v, 0.0..=1.0)
-                            .show_value(false)
-                            .clamping(egui::SliderClamping::Never);
-                        if ui.add(slider).changed() {
-                            changed = Some(Value::Scalar(v.clamp(0.0, param.max())));
-                        }
-                        let field = egui::DragValue::new(&mut v).range(0.0..=param.max()).speed(0.005).max_decimals(4);
-                        if ui.add(field).on_hover_text(format!("0 to {}", param.max())).changed() {
-                            changed = Some(Value::Scalar(v));
-                        }
-                    });
-                }
-            }
-            if let Some(value) = changed {
-                actions.push(Action::Drag(Edit::SetParam { object, layer: index, param, value }));
-            }
-            let reset = ui.add_enabled(overridden, egui::Button::new("↺").small());
-            if reset.on_hover_text("Reset to the preset's value").clicked() {
-                actions.push(Action::Edit(Edit::ResetParam { object, layer: index, param }));
-            }
-            ui.end_row();
+    }
+}
+
+/// One parameter's row: override dot, name (a map menu where maps can bind), value, reset.
+fn parameter_row(
+    ui: &mut egui::Ui,
+    session: &Session,
+    object: ObjectRef,
+    index: usize,
+    layer: &Layer,
+    param: Param,
+    actions: &mut Vec<Action>,
+) {
+    let document = &session.document;
+    let with_maps = !session.gbuffer.maps.is_empty() || !layer.maps.is_empty();
+    let overridden = document.is_overridden(object, index, param);
+    let preset_value = document.preset_value(object, index, param);
+    override_dot(ui, overridden).on_hover_text(if overridden {
+        format!("Overridden; the preset has {preset_value}")
+    } else {
+        "The preset's value".to_string()
+    });
+    let bound = layer.maps.get(&param);
+    let meaning = physical::describe(param, &layer.params);
+    // One width for the names in every group's grid, so the values line up down the panel.
+    ui.horizontal(|ui| {
+        ui.set_min_width(NAME_WIDTH);
+        if with_maps {
+            map_choice(ui, session, param, bound, &meaning, actions);
+        } else {
+            ui.label(param.name()).on_hover_text(meaning);
         }
     });
+    let value = layer.params.get(param);
+    let mut changed = None;
+    match value {
+        Value::Color(mut rgb) => {
+            ui.horizontal(|ui| {
+                // egui's picker works in sRGB and hands back linear values, as stored; it
+                // holds [0, 1], so emission above 1 is typed into the fields.
+                if rgb.iter().all(|&c| c <= 1.0)
+                    && egui::widgets::color_picker::color_edit_button_rgb(ui, &mut rgb).changed()
+                {
+                    changed = Some(Value::Color(rgb));
+                }
+                for channel in 0..3 {
+                    let drag =
+                        egui::DragValue::new(&mut rgb[channel]).range(0.0..=param.max()).speed(0.002).max_decimals(4);
+                    if ui.add(drag).on_hover_text("Linear value").changed() {
+                        changed = Some(Value::Color(rgb));
+                    }
+                }
+            });
+        }
+        Value::Scalar(mut v) => {
+            ui.horizontal(|ui| {
+                // The slider spans the plausible range; the field takes typed values up
+                // to the format's limit.
+                let slider =
+                    egui::Slider::new(&mut v, 0.0..=1.0).show_value(false).clamping(egui::SliderClamping::Never);
+                if ui.add(slider).changed() {
+                    changed = Some(Value::Scalar(v.clamp(0.0, param.max())));
+                }
+                let field = egui::DragValue::new(&mut v).range(0.0..=param.max()).speed(0.005).max_decimals(4);
+                if ui.add(field).on_hover_text(format!("0 to {}", param.max())).changed() {
+                    changed = Some(Value::Scalar(v));
+                }
+            });
+        }
+    }
+    if let Some(value) = changed {
+        actions.push(Action::Drag(Edit::SetParam { object, layer: index, param, value }));
+    }
+    let reset = ui.add_enabled(overridden, egui::Button::new("↺").small());
+    if reset.on_hover_text("Reset to the preset's value").clicked() {
+        actions.push(Action::Edit(Edit::ResetParam { object, layer: index, param }));
+    }
 }
 
 /// The parameter's name as a menu of the g-buffer's maps it can be bound to: blue when bound,
 /// with the map named on hover.
-fn map_choice(ui: &mut egui::Ui, session: &Session, param: Param, bound: Option<&String>, actions: &mut Vec<Action>) {
+fn map_choice(
+    ui: &mut egui::Ui,
+    session: &Session,
+    param: Param,
+    bound: Option<&String>,
+    meaning: &str,
+    actions: &mut Vec<Action>,
+) {
     let mut title = RichText::new(param.name());
     if bound.is_some() {
         title = title.color(ui.visuals().hyperlink_color);
@@ -314,8 +354,8 @@ fn map_choice(ui: &mut egui::Ui, session: &Session, param: Param, bound: Option<
         }
     });
     menu.response.on_hover_text(match bound {
-        Some(map) => format!("Bound: the value times map.{map} at each pixel. Click to change."),
-        None => "Click to bind to a g-buffer map".to_string(),
+        Some(map) => format!("{meaning}\n\nBound: the value times map.{map} at each pixel. Click to change."),
+        None => format!("{meaning}\n\nClick to bind to a g-buffer map"),
     });
 }
 

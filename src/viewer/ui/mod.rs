@@ -8,6 +8,7 @@
 mod browser;
 mod compare;
 mod dialogs;
+pub mod hotkeys;
 mod inspector;
 mod layers;
 mod lighting;
@@ -66,6 +67,8 @@ pub struct Interface {
     pub message: Option<Message>,
     /// Where the image was drawn last frame, in window pixels.
     pub placement: Option<ImagePlacement>,
+    /// The hotkey sheet is open.
+    pub hotkeys: bool,
 }
 
 impl Interface {
@@ -130,6 +133,7 @@ impl Interface {
         if let Some(pending) = frame.pending {
             dialogs::unsaved_question(&ctx, frame.session, pending, actions);
         }
+        hotkeys::show(&ctx, &mut self.hotkeys);
         // A drag of any control ends when the pointer is let go: the next change is a new step.
         if ui.input(|i| i.pointer.any_released()) {
             actions.push(Action::EndGesture);
@@ -164,6 +168,9 @@ impl Interface {
             }
             if input.consume_key(Modifiers::NONE, Key::Num1) {
                 self.viewport.actual_pixels();
+            }
+            if input.consume_key(Modifiers::NONE, Key::Questionmark) {
+                self.hotkeys = !self.hotkeys;
             }
         });
     }
@@ -220,6 +227,11 @@ impl Interface {
                 }
                 if ui.add(egui::Button::new("Actual pixels (1:1)").shortcut_text("1")).clicked() {
                     self.viewport.actual_pixels();
+                }
+            });
+            ui.menu_button("Help", |ui| {
+                if ui.add(egui::Button::new("Hotkeys").shortcut_text("?")).clicked() {
+                    self.hotkeys = true;
                 }
             });
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {

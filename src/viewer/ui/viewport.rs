@@ -231,7 +231,7 @@ impl Viewport {
             painter.text(
                 rect.left_bottom() + vec2(10.0, -8.0),
                 egui::Align2::LEFT_BOTTOM,
-                "click: inspect · Shift+drag: rotate light · drag: pan · wheel: zoom · F: fit · 1: 1:1",
+                "click: inspect · Shift+drag: rotate light · drag: pan · wheel: zoom · F: fit · 1: 1:1 · ?: hotkeys",
                 font,
                 Color32::from_gray(130),
             );
