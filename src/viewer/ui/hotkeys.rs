@@ -37,6 +37,11 @@ pub const GESTURES: &[Hotkey] = &[
 /// window, over the image; it appears and goes at once (no fade), so a screenshot of the frame
 /// after the key shows it whole or not at all.
 pub fn show(ctx: &egui::Context, open: &mut bool) {
+    // A closed window is not shown at all: egui would otherwise draw it on while its fade-out
+    // animation runs, for a time rather than a number of frames.
+    if !*open {
+        return;
+    }
     egui::Window::new("Hotkeys")
         .open(open)
         .collapsible(false)
