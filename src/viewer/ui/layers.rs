@@ -372,7 +372,61 @@ fn override_dot(ui: &mut egui::Ui, overridden: bool) -> egui::Response {
 
 #[cfg(test)]
 mod tests {
-    use super::drop_index;
+    use super::*;
+    use crate::gpu::{Context, ContextOptions};
+    use crate::material::params::Group;
+    use crate::render::scene::{GBufferSpec, Scene, SceneSpec};
+    use crate::viewer_state::Document;
+
+    fn texts(shape: &egui::Shape, out: &mut Vec<String>) {
+        match shape {
+            egui::Shape::Text(text) => out.push(text.galley.text().to_string()),
+            egui::Shape::Vec(shapes) => shapes.iter().for_each(|s| texts(s, out)),
+            _ => {}
+        }
+    }
+
+    /// The panel shows the selected layer's parameters under their groups' headers, in the
+    /// table's order: each name after its own header and before the next.
+    #[test]
+    fn the_parameters_show_under_their_groups() {
+        let ctx = Context::new(&ContextOptions::from_env(std::env::var("LOOKDEV_TEST_DEVICE").ok())).unwrap();
+        let spec = SceneSpec {
+            gbuffer: GBufferSpec { builtin_size: Some((32, 32)), ..GBufferSpec::default() },
+            ..SceneSpec::default()
+        };
+        let scene = Scene::load(&spec).unwrap();
+        let mut document = Document::new(scene.look.clone(), None, scene.settings.clone());
+        document.select(Selection { object: Some(ObjectRef::Id(1)), layer: Some(0) });
+        let session =
+            Session::new(&ctx, scene.gbuffer, scene.gbuffer_name, document, scene.environment, Default::default())
+                .unwrap();
+        let egui = egui::Context::default();
+        let mut actions = Vec::new();
+        let mut shown = Vec::new();
+        for _ in 0..2 {
+            // The second pass lays out with the sizes the first measured.
+            let output = egui.run_ui(egui::RawInput::default(), |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| show(ui, &session, &mut actions));
+            });
+            shown.clear();
+            output.shapes.iter().for_each(|clipped| texts(&clipped.shape, &mut shown));
+        }
+        let at =
+            |text: &str| shown.iter().position(|t| t == text).unwrap_or_else(|| panic!("no '{text}' in {shown:?}"));
+        let headers: Vec<usize> = GROUPS.iter().map(|(group, _)| at(group.name())).collect();
+        assert!(headers.windows(2).all(|w| w[0] < w[1]), "the groups in order: {shown:?}");
+        for (index, (group, params)) in GROUPS.iter().enumerate() {
+            let end = headers.get(index + 1).copied().unwrap_or(usize::MAX);
+            for param in params.iter() {
+                let place = at(param.name());
+                assert!(headers[index] < place && place < end, "{param} is not under {}: {shown:?}", group.name());
+            }
+        }
+        assert_eq!(Group::Base.params()[0], Param::BaseColor);
+        drop(session);
+        drop(ctx);
+    }
 
     /// Dropped above or below any layer, dragging up or down, a layer lands next to it, on the
     /// side the drop line showed, and the others keep their order.
