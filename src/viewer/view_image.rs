@@ -217,10 +217,14 @@ impl Views {
                 None => self.texture = Some(egui.load_texture("view", colour, options)),
             }
         }
+        // A radiance view is marked everywhere; a value view only where it has values.
+        let coverage = &session.gbuffer.coverage;
+        let everywhere = image.view.is_radiance();
         let marks: Vec<egui::Color32> = image
             .display
             .iter()
-            .map(|d| match views::clip_mark(*d) {
+            .zip(coverage)
+            .map(|(d, &a)| match views::clip_mark(*d).filter(|_| everywhere || a > 0.0) {
                 Some(m) => egui::Color32::from_rgb(m[0], m[1], m[2]),
                 None => egui::Color32::TRANSPARENT,
             })

@@ -115,12 +115,19 @@ pub fn decorate(ui: &egui::Ui, session: &Session, state: &Views, image: Option<R
 /// bottom edge where the view has no room below it).
 fn legend(painter: &egui::Painter, view: Rect, image: Rect) {
     let swatch = vec2(30.0, 16.0);
-    let width = swatch.x * FALSE_COLOURS.len() as f32;
+    let caption = painter.layout_no_wrap(
+        "stops about 18% grey".into(),
+        egui::FontId::proportional(10.0),
+        Color32::from_gray(180),
+    );
+    let swatches = swatch.x * FALSE_COLOURS.len() as f32;
+    let width = swatches + 6.0 + caption.size().x;
     let height = swatch.y + 14.0;
     let top = if image.max.y + 4.0 + height <= view.max.y { image.max.y + 4.0 } else { image.max.y - height - 2.0 };
-    let left = (image.center().x - width / 2.0).max(view.min.x + 2.0);
+    // Centred under the image, kept inside the view.
+    let left = (image.center().x - width / 2.0).min(view.max.x - width - 4.0).max(view.min.x + 4.0);
     painter.rect_filled(
-        Rect::from_min_size(pos2(left - 2.0, top - 2.0), vec2(width + 4.0, height + 4.0)),
+        Rect::from_min_size(pos2(left - 2.0, top - 2.0), vec2(width + 6.0, height + 4.0)),
         2.0,
         Color32::from_black_alpha(190),
     );
@@ -135,13 +142,8 @@ fn legend(painter: &egui::Painter, view: Rect, image: Rect) {
             Color32::from_gray(220),
         );
     }
-    painter.text(
-        pos2(left + width + 6.0, top + swatch.y / 2.0),
-        egui::Align2::LEFT_CENTER,
-        "stops about 18% grey",
-        egui::FontId::proportional(10.0),
-        Color32::from_gray(180),
-    );
+    let at = pos2(left + swatches + 6.0, top + (swatch.y - caption.size().y) / 2.0);
+    painter.galley(at, caption, Color32::from_gray(180));
 }
 
 /// The histogram of the current view's luminance: stops about 18% grey for radiance views,
