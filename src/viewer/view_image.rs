@@ -153,7 +153,7 @@ impl Views {
     fn refresh(&mut self, session: &mut Session) -> Result<()> {
         let view = self.current.clone();
         let settings = session.document.settings().clone();
-        let (channels, linear, shown): (usize, Vec<[f32; 3]>, Option<Vec<[f32; 3]>>) = match &view {
+        let Values { channels, linear, shown } = match &view {
             View::Beauty | View::FalseColour => {
                 let radiance = session.radiance()?;
                 let linear = radiance.iter().map(|r| [r[0], r[1], r[2]]).collect();
@@ -169,7 +169,7 @@ impl Views {
                         }
                     })
                     .collect();
-                (3, linear, Some(shown))
+                Values { channels: 3, linear, shown: Some(shown) }
             }
             View::Aov(aov) => layer_values(session.aov_layers(&[*aov])?.into_iter().next())?,
             View::Mask(name) => find_layer(session.aov_layers(&[Aov::Masks])?, &aov::mask_layer(name))?,
@@ -288,16 +288,24 @@ impl Views {
     }
 }
 
+/// A view's values as read: linear, and where the display shows other values (the beauty's
+/// surface colour, with the background off), those.
+struct Values {
+    channels: usize,
+    linear: Vec<[f32; 3]>,
+    shown: Option<Vec<[f32; 3]>>,
+}
+
 /// The values of an AOV layer of one or three channels.
-fn layer_values(layer: Option<aov::Layer>) -> Result<(usize, Vec<[f32; 3]>, Option<Vec<[f32; 3]>>)> {
+fn layer_values(layer: Option<aov::Layer>) -> Result<Values> {
     let layer = layer.ok_or_else(|| Error::gpu("the view's AOV has no layer"))?;
     let channel = |k: usize| &layer.channels[k.min(layer.channels.len() - 1)].1;
     let channels = if layer.channels.len() >= 3 { 3 } else { 1 };
     let values = (0..channel(0).len()).map(|p| [channel(0)[p], channel(1)[p], channel(2)[p]]).collect();
-    Ok((channels, values, None))
+    Ok(Values { channels, linear: values, shown: None })
 }
 
 /// The layer named `name` among an AOV's layers.
-fn find_layer(layers: Vec<aov::Layer>, name: &str) -> Result<(usize, Vec<[f32; 3]>, Option<Vec<[f32; 3]>>)> {
+fn find_layer(layers: Vec<aov::Layer>, name: &str) -> Result<Values> {
     layer_values(layers.into_iter().find(|l| l.name == name))
 }
