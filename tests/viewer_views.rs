@@ -207,31 +207,20 @@ fn probe_gives_the_values_render_writes_as_aovs() {
     case.write(
         "probe.script",
         &format!(
-            "view roughness\nprobe {x} {y}\nview diffuse\nwait-spp 4\nprobe {x} {y}\nview mask.stripes\nprobe {x} {y}\n"
+            "view roughness\nprobe {x} {y}\nview diffuse\nwait-spp 4\nprobe {x} {y}\nview mask.stripes\nprobe {x} {y}\n\
+             view layers_ball_1_gold\nprobe {x} {y}\nview N\nprobe {x} {y}\n"
         ),
     );
     let output = case.view(&["look.toml", "--script", "probe.script", "--exit-after-spp", "4"]);
     assert_success(&output);
     let probes = probes(&output);
-    assert_eq!(probes.len(), 3, "{}", stdout(&output));
+    assert_eq!(probes.len(), 5, "{}", stdout(&output));
+    let aovs = ["roughness", "diffuse", "masks", "layers", "N"].map(|a| ["--aov", a]).concat();
     let args = [
-        "render",
-        "--gbuffer",
-        "g.exr",
-        "--look",
-        "look.toml",
-        "--spp",
-        "4",
-        "--quiet",
-        "--aov",
-        "roughness",
-        "--aov",
-        "diffuse",
-        "--aov",
-        "masks",
-        "--out",
-        "r.exr",
-    ];
+        &["render", "--gbuffer", "g.exr", "--look", "look.toml", "--spp", "4", "--quiet", "--out", "r.exr"][..],
+        &aovs,
+    ]
+    .concat();
     assert_success(&case.command(&args).output().unwrap());
     let exr = exr::prelude::read_all_flat_layers_from_file(case.path("r.exr")).unwrap();
     let channel = |name: &str| -> f32 {
@@ -243,6 +232,8 @@ fn probe_gives_the_values_render_writes_as_aovs() {
         (&probes[0], "param_roughness", &["Y"][..]),
         (&probes[1], "diffuse", &["R", "G", "B"][..]),
         (&probes[2], "mask_stripes", &["Y"][..]),
+        (&probes[3], "layers_ball_1_gold", &["Y"][..]),
+        (&probes[4], "N", &["R", "G", "B"][..]),
     ] {
         let linear: Vec<f32> = line
             .split(" linear ")
@@ -264,6 +255,9 @@ fn probe_gives_the_values_render_writes_as_aovs() {
     let roughness: f32 = probes[0].split(" linear ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
     let byte = value_byte(roughness);
     assert!(probes[0].ends_with(&format!("display {byte},{byte},{byte}")), "{}", probes[0]);
+    // N shows as 0.5·(n + 1) by the value rule, as a normal map stores it.
+    let n = g.normal[ball].map(|c| value_byte(0.5 * (c + 1.0)));
+    assert!(probes[4].ends_with(&format!("display {},{},{}", n[0], n[1], n[2])), "{}", probes[4]);
 }
 
 #[test]

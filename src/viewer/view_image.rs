@@ -8,6 +8,7 @@ use super::session::Session;
 use super::views::{self, Histogram, View, ViewChoice};
 use crate::render::aov::{self, Aov};
 use crate::{Error, Result};
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 /// The longest the copy lags the accumulation.
@@ -24,9 +25,9 @@ pub struct ViewImage {
     /// Display-referred sRGB bytes per pixel, as the view shows them.
     pub display: Vec<[u8; 3]>,
     pub histogram: Option<Histogram>,
-    /// The samples and the document revision it was read at.
+    /// The samples and the document's edition it was read at.
     pub samples: u32,
-    revision: u64,
+    edition: Edition,
 }
 
 impl ViewImage {
@@ -53,8 +54,9 @@ pub struct Views {
     image: Option<ViewImage>,
     texture: Option<egui::TextureHandle>,
     overlay: Option<egui::TextureHandle>,
-    /// The overlay shows the marks of this copy (its samples and revision) and view.
-    overlay_of: Option<(View, u32, u64)>,
+    /// The textures show this copy (its view, samples and edition), and whether the overlay
+    /// was made (only while it is on).
+    overlay_of: Option<(View, u32, Edition, bool)>,
     refreshed_at: Instant,
 }
 
@@ -135,7 +137,7 @@ impl Views {
     fn due(&self, session: &Session) -> bool {
         let samples = session.a_samples();
         let Some(image) = &self.image else { return self.readable(session) };
-        if image.view != self.current || image.revision != session.document.revision() {
+        if image.view != self.current || image.edition != edition(session) {
             return self.readable(session);
         }
         if !self.current.follows_samples() || samples == image.samples || samples == 0 {
@@ -192,7 +194,7 @@ impl Views {
             display,
             histogram,
             samples: session.a_samples(),
-            revision: session.document.revision(),
+            edition: edition(session),
         });
         self.refreshed_at = Instant::now();
         Ok(())
@@ -202,10 +204,11 @@ impl Views {
     fn upload(&mut self, session: &Session, egui: &egui::Context) {
         let Some(image) = &self.image else { return };
         let size = [session.width() as usize, session.height() as usize];
-        let key = (image.view.clone(), image.samples, image.revision);
+        let key = (image.view.clone(), image.samples, image.edition.clone(), self.clipping);
         if self.overlay_of.as_ref() == Some(&key) {
             return;
         }
+        self.overlay_of = Some(key);
         let options =
             egui::TextureOptions { magnification: egui::TextureFilter::Nearest, ..egui::TextureOptions::LINEAR };
         if image.view != View::Beauty {
@@ -216,6 +219,9 @@ impl Views {
                 Some(texture) => texture.set(colour, options),
                 None => self.texture = Some(egui.load_texture("view", colour, options)),
             }
+        }
+        if !self.clipping {
+            return; // made when the overlay is turned on
         }
         // A radiance view is marked everywhere; a value view only where it has values.
         let coverage = &session.gbuffer.coverage;
@@ -234,7 +240,6 @@ impl Views {
             Some(overlay) => overlay.set(marks, options),
             None => self.overlay = Some(egui.load_texture("clipping", marks, options)),
         }
-        self.overlay_of = Some(key);
     }
 
     /// The current view's copy, when it has been read for the current view.
@@ -251,7 +256,7 @@ impl Views {
 
     /// The clipping overlay's texture, while it is on and made for the current view.
     pub fn overlay(&self) -> Option<egui::TextureId> {
-        let current = self.overlay_of.as_ref().is_some_and(|(view, ..)| *view == self.current);
+        let current = self.overlay_of.as_ref().is_some_and(|(view, .., made)| *view == self.current && *made);
         self.overlay.as_ref().filter(|_| self.clipping && current).map(egui::TextureHandle::id)
     }
 
@@ -271,8 +276,7 @@ impl Views {
         }
         self.sync_accumulate(session)?;
         let stale = self.image().is_none_or(|i| {
-            i.revision != session.document.revision()
-                || (self.current.follows_samples() && i.samples != session.a_samples())
+            i.edition != edition(session) || (self.current.follows_samples() && i.samples != session.a_samples())
         });
         if stale {
             if !self.readable(session) {
@@ -286,6 +290,14 @@ impl Views {
         let image = self.image().expect("just read");
         Ok(image.describe(x, y).expect("inside the image"))
     }
+}
+
+/// What the document's content is known by: its revision, which changes with every change,
+/// and its file, since another look opened starts at revision 0 again.
+type Edition = (u64, Option<std::path::PathBuf>);
+
+fn edition(session: &Session) -> Edition {
+    (session.document.revision(), session.document.path().map(Path::to_path_buf))
 }
 
 /// A view's values as read: linear, and where the display shows other values (the beauty's
