@@ -38,7 +38,8 @@ pub struct RenderArgs {
     pub compare: Option<Option<PathBuf>>,
     /// Write an AOV beside the beauty in EXR output (repeatable; instead of the look's
     /// [render] aovs): diffuse, specular, clearcoat, sheen, emission, albedo, a parameter's name,
-    /// layers, N, V, objectId, variance, or the groups light, material, geometry, error, all.
+    /// layers, N, V, objectId, variance, masks, maps, or the groups light, material, geometry, error,
+    /// inputs, all.
     #[arg(long = "aov", value_name = "NAME")]
     pub aovs: Vec<String>,
     /// PNG output: show this AOV instead of the beauty.
@@ -133,7 +134,7 @@ fn display_aov(name: &str, format: OutputFormat) -> Result<Aov> {
         return Err(Error::input(format!("--aov-display {name}: only a PNG shows one AOV; an EXR takes --aov")));
     }
     match Aov::parse(name).map_err(|e| Error::input(format!("--aov-display: {e}")))?[..] {
-        [aov] if aov != Aov::Layers => Ok(aov),
+        [aov] if !matches!(aov, Aov::Layers | Aov::Masks | Aov::Maps) => Ok(aov),
         _ => Err(Error::input(format!("--aov-display {name}: name one AOV, not a group"))),
     }
 }
@@ -156,7 +157,7 @@ fn write_aov_png(
         let rgb = match aov {
             a if a.is_radiance() => crate::shading::tonemap::display_pixel(value, settings.exposure, settings.tonemap),
             Aov::Normal | Aov::View => encode(value * 0.5 + 0.5),
-            Aov::ObjectId => id_colour(value.x as u32),
+            Aov::ObjectId => crate::render::aov::id_colour(value.x as u32),
             Aov::Variance => encode(glam::Vec3::splat(value.x.sqrt())),
             _ => encode(value),
         };
@@ -168,15 +169,6 @@ fn write_aov_png(
 /// A value in [0, 1] as sRGB bytes.
 fn encode(v: glam::Vec3) -> [u8; 3] {
     v.to_array().map(|c| (crate::shading::tonemap::srgb_encode(c.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8)
-}
-
-/// A distinct colour per object id (0, the background, black).
-fn id_colour(id: u32) -> [u8; 3] {
-    if id == 0 {
-        return [0; 3];
-    }
-    let h = id.wrapping_mul(0x9e37_79b9);
-    [(h >> 24) as u8 | 0x40, (h >> 16) as u8 | 0x40, (h >> 8) as u8 | 0x40]
 }
 
 fn write(path: &Path, format: OutputFormat, rendered: &Rendered, background: bool, metadata: &Metadata) -> Result<()> {

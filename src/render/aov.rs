@@ -9,6 +9,8 @@
 //! - Layers: `layers`, each layer's share of the blend, for every layer of every stack.
 //! - Geometry: `N`, `V` and `objectId`, as the g-buffer has them.
 //! - Error: `variance`, of each pixel's mean luminance.
+//! - Inputs: `masks` and `maps`, the g-buffer's masks and maps as read, as `mask_<name>` and
+//!   `map_<name>`.
 
 use crate::gbuffer::GBuffer;
 use crate::lab::albedo::AlbedoTables;
@@ -31,14 +33,19 @@ pub enum Aov {
     View,
     ObjectId,
     Variance,
+    /// Every g-buffer mask, as `mask_<name>.Y`.
+    Masks,
+    /// Every g-buffer map, as `map_<name>.R/G/B` (a colour map) or `map_<name>.Y`.
+    Maps,
 }
 
 /// Names that stand for several AOVs.
-const GROUPS: [(&str, &str); 5] = [
+const GROUPS: [(&str, &str); 6] = [
     ("light", "diffuse, specular, clearcoat, sheen and emission"),
     ("material", "albedo and every parameter"),
     ("geometry", "N, V and objectId"),
     ("error", "variance"),
+    ("inputs", "masks and maps"),
     ("all", "every AOV"),
 ];
 
@@ -49,7 +56,7 @@ impl Aov {
         all.push(Aov::Emission);
         all.push(Aov::Albedo);
         all.extend(Param::ALL.into_iter().filter(|p| *p != Param::Emission).map(Aov::Param));
-        all.extend([Aov::Layers, Aov::Normal, Aov::View, Aov::ObjectId, Aov::Variance]);
+        all.extend([Aov::Layers, Aov::Normal, Aov::View, Aov::ObjectId, Aov::Variance, Aov::Masks, Aov::Maps]);
         all
     }
 
@@ -65,6 +72,8 @@ impl Aov {
             Aov::View => "V".into(),
             Aov::ObjectId => "objectId".into(),
             Aov::Variance => "variance".into(),
+            Aov::Masks => "masks".into(),
+            Aov::Maps => "maps".into(),
         }
     }
 
@@ -78,6 +87,7 @@ impl Aov {
             "material" => Some(all.iter().copied().filter(|a| matches!(a, Aov::Albedo | Aov::Param(_))).collect()),
             "geometry" => Some(vec![Aov::Normal, Aov::View, Aov::ObjectId]),
             "error" => Some(vec![Aov::Variance]),
+            "inputs" => Some(vec![Aov::Masks, Aov::Maps]),
             "all" => Some(all.clone()),
             _ => None,
         };
@@ -216,9 +226,62 @@ pub fn layers(aovs: &[Aov], sources: &Sources) -> Result<Vec<Layer>> {
             Aov::View => out.push(Layer::color(aov.name(), g.view.iter().copied())),
             Aov::ObjectId => out.push(Layer::scalar(aov.name(), g.object_id.iter().map(|&id| id as f32).collect())),
             Aov::Variance => out.push(Layer::scalar(aov.name(), sources.renderer.read_variance(coverage)?)),
+            Aov::Masks => {
+                out.extend(g.masks.iter().map(|(name, values)| Layer::scalar(mask_layer(name), values.clone())))
+            }
+            Aov::Maps => out.extend(map_layers(g)),
         }
     }
     Ok(out)
+}
+
+/// The layer a g-buffer mask is written as: `mask_<name>`.
+pub fn mask_layer(mask: &str) -> String {
+    format!("mask_{}", crate::asset::channel_name(mask))
+}
+
+/// The layer a g-buffer map (as [`GBuffer::maps`] names it) is written as: `map_<name>`.
+pub fn map_layer(map: &str) -> String {
+    format!("map_{}", crate::asset::channel_name(map))
+}
+
+/// One layer per map, as read: a colour map as RGB, a scalar map as Y.
+fn map_layers(g: &GBuffer) -> Vec<Layer> {
+    g.maps()
+        .into_iter()
+        .filter_map(|map| match g.map_source(&map.name)? {
+            crate::gbuffer::MapSource::Color([r, gr, b]) => {
+                let (r, gr, b) = (&g.maps[&r], &g.maps[&gr], &g.maps[&b]);
+                Some(Layer::color(map_layer(&map.name), (0..r.len()).map(|p| [r[p], gr[p], b[p]])))
+            }
+            crate::gbuffer::MapSource::Channel(channel) => {
+                Some(Layer::scalar(map_layer(&map.name), g.maps[&channel].clone()))
+            }
+        })
+        .collect()
+}
+
+/// The names of the `layers` AOV's layers, in the order [`layers`] writes them, each with the
+/// label of the stack it belongs to and the layer's index in it.
+pub fn layer_weight_names(gbuffer: &GBuffer, look: &Look) -> Vec<String> {
+    let mut names = Vec::new();
+    for stack in &look.objects {
+        let label = stack_label(stack, gbuffer);
+        for (i, layer) in stack.layers.iter().enumerate() {
+            names.push(format!("layers_{label}_{i}_{}", preset_label(layer.preset.as_deref())));
+        }
+    }
+    names
+}
+
+/// A distinct colour per object id, as sRGB bytes (0, the background, black): a hash of the id,
+/// so the same id has the same colour in every run and every tool.
+pub fn id_colour(id: u32) -> [u8; 3] {
+    if id == 0 {
+        return [0; 3];
+    }
+    let h = id.wrapping_mul(0x9e37_79b9);
+    [(h >> 24) as u8 | 0x40, (h >> 16) as u8 | 0x40, (h >> 8) as u8 | 0x40]
 }
 
 fn color_of(m: &Params, param: Param) -> [f32; 3] {
@@ -264,9 +327,13 @@ fn layer_weight_layers(sources: &Sources) -> Vec<Layer> {
                 values[i][p] = weight.map_or(0.0, |w| w.contribution);
             }
         }
-        for (i, (layer, values)) in stack.layers.iter().zip(values).enumerate() {
-            let preset = preset_label(layer.preset.as_deref());
-            out.push(Layer::scalar(format!("layers_{label}_{i}_{preset}"), values));
+        let names = stack
+            .layers
+            .iter()
+            .enumerate()
+            .map(|(i, layer)| format!("layers_{label}_{i}_{}", preset_label(layer.preset.as_deref())));
+        for (name, values) in names.zip(values) {
+            out.push(Layer::scalar(name, values));
         }
     }
     out

@@ -124,6 +124,11 @@ impl Renderer {
         self.respecialize(self.relight.shading.model, accumulate)
     }
 
+    /// What the relight kernel accumulates beside the total.
+    pub fn accumulate(&self) -> Accumulate {
+        self.relight.accumulate
+    }
+
     /// A new relight pass for this model and accumulation.
     fn respecialize(&mut self, model: Model, accumulate: Accumulate) -> Result<()> {
         self.relight =

@@ -65,6 +65,15 @@ pub enum Action {
     Key(egui::Key, egui::Modifiers),
     /// Sets the zoom: `None` fits the image to the view, else window pixels per image pixel.
     Zoom(Option<f32>),
+    /// Shows another view instead of the beauty (or the beauty again).
+    View(super::views::ViewChoice),
+    /// Turns the clipping overlay on or off (`None`: toggles it).
+    Clipping(Option<bool>),
+    /// Prints the current view's values at image pixel (x, y) (a script's `probe`).
+    Probe {
+        x: u32,
+        y: u32,
+    },
 }
 
 /// What to show as B, beside the edited look (A).

@@ -10,6 +10,7 @@ use super::script::{ScriptRunner, Step};
 use super::session::Session;
 use super::thumbnails::{self, Thumbnails};
 use super::ui::{FileDialog, FilePurpose, Frame, FrameFigures, Interface, Pending};
+use super::view_image::Views;
 use super::ViewOptions;
 use crate::gpu::context::{Presentation, ValidationCounter};
 use crate::gpu::{Context, ContextOptions};
@@ -148,6 +149,7 @@ struct Running {
     title: String,
     next_repaint: Option<Instant>,
     quit: bool,
+    views: Views,
 }
 
 impl Running {
@@ -209,6 +211,7 @@ impl Running {
             title: String::new(),
             next_repaint: None,
             quit: false,
+            views: Views::default(),
         };
         running.update_title();
         running.window.request_redraw();
@@ -269,6 +272,7 @@ impl Running {
         };
         // B's textures now name only a live image (or none): a replaced B can go.
         self.session.drop_retired()?;
+        self.views.update(&mut self.session, &self.gui.egui)?;
         let mut actions = Vec::new();
         let frame = Frame {
             session: &self.session,
@@ -276,6 +280,7 @@ impl Running {
             compare_texture,
             pending: self.pending.as_ref(),
             figures: FrameFigures { frame: self.clock.recent_mean() },
+            views: &self.views,
         };
         let output =
             self.gui.run(&self.window, |ui| self.interface.show(ui, &frame, &mut self.thumbnails, &mut actions));
@@ -465,6 +470,13 @@ impl Running {
             }
             Action::Key(key, modifiers) => self.gui.press_key(key, modifiers),
             Action::Zoom(scale) => self.interface.viewport.zoom_to(scale),
+            Action::View(choice) => return self.views.choose(&mut self.session, choice).map(Some),
+            Action::Clipping(on) => return Ok(Some(self.views.set_clipping(on))),
+            Action::Probe { x, y } => {
+                let line = self.views.probe(&mut self.session, x, y)?;
+                println!("lookdev: {line}");
+                return Ok(Some(line));
+            }
             Action::Answer(answer) => {
                 let pending = self.pending.take().ok_or_else(|| Error::input("there is no question to answer"))?;
                 match answer {

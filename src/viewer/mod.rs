@@ -7,6 +7,9 @@
 //! - [`script`] reads the same actions from a file, for tests and automation.
 //! - [`app`] owns the window and runs a frame: script step, relight band, interface, present.
 //! - [`presenter`], [`gui`] and [`progressive`] are the plumbing under it.
+//! - [`views`] and [`view_image`]: the views shown instead of the beauty (AOVs, false colour),
+//!   and the current one's CPU copy for the histogram, clipping overlay and values under the
+//!   cursor.
 
 mod action;
 mod app;
@@ -18,6 +21,8 @@ mod script;
 mod session;
 pub mod thumbnails;
 mod ui;
+mod view_image;
+pub mod views;
 
 pub use action::Action;
 pub use script::{zoom, Script, Step};

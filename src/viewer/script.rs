@@ -62,7 +62,7 @@ impl LayerChange {
 /// The commands, for the error that names an unknown one.
 const COMMANDS: &str = "select, set, reset, map, add, remove, duplicate, move, show, hide, mask, invert, opacity, \
     rotate, intensity, background, env, exposure, tonemap, spp, seed, undo, redo, pick, inspect, wait-spp, save-look, \
-    save-preset, save-image, screenshot, open-look, quit, answer, compare, divider, key, zoom";
+    save-preset, save-image, screenshot, open-look, quit, answer, compare, divider, key, zoom, view, clipping, probe";
 
 impl Script {
     pub fn load(path: &Path) -> Result<Script> {
@@ -324,6 +324,19 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
             arity(1)?;
             Ok(Step::Do(Action::Zoom(zoom(args[0])?)))
         }
+        // The view's name is checked when the line runs, against the session's views.
+        "view" => {
+            arity(1)?;
+            Ok(Step::Do(Action::View(super::views::ViewChoice::Named(args[0].to_string()))))
+        }
+        "clipping" => {
+            arity(1)?;
+            Ok(Step::Do(Action::Clipping(Some(switch(args[0])?))))
+        }
+        "probe" => {
+            arity(2)?;
+            Ok(Step::Do(Action::Probe { x: number(args[0], "x")?, y: number(args[1], "y")? }))
+        }
         other => Err(format!("unknown command '{other}' (expected one of: {COMMANDS})")),
     }
 }
@@ -471,6 +484,26 @@ mod tests {
             ("key super+C", "unknown modifier 'super'"),
             ("zoom 100", "zoom '100' is neither 'fit' nor a scale"),
             ("zoom", "'zoom' takes 1 argument"),
+        ] {
+            let message = parse(line).unwrap_err().to_string();
+            assert!(message.contains(problem), "{line}: {message}");
+        }
+    }
+
+    #[test]
+    fn view_clipping_and_probe_parse_to_their_actions() {
+        use crate::viewer::views::ViewChoice;
+        let script = parse("view mask.stripes\nclipping on\nclipping off\nprobe 3 4\n").unwrap();
+        let steps: Vec<&Step> = script.steps.iter().map(|(_, s)| s).collect();
+        assert_eq!(*steps[0], Step::Do(Action::View(ViewChoice::Named("mask.stripes".into()))));
+        assert_eq!(*steps[1], Step::Do(Action::Clipping(Some(true))));
+        assert_eq!(*steps[2], Step::Do(Action::Clipping(Some(false))));
+        assert_eq!(*steps[3], Step::Do(Action::Probe { x: 3, y: 4 }));
+        for (line, problem) in [
+            ("view", "'view' takes 1 argument, not 0"),
+            ("clipping maybe", "'maybe' is not on or off"),
+            ("probe 1", "'probe' takes 2 arguments"),
+            ("probe -1 2", "x '-1' is not a whole number"),
         ] {
             let message = parse(line).unwrap_err().to_string();
             assert!(message.contains(problem), "{line}: {message}");

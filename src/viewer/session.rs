@@ -603,6 +603,42 @@ impl Session {
         self.inspection = None;
         self.apply_changes(true)
     }
+
+    /// What A's renderer accumulates beside the total, for the light and variance views. A
+    /// change restarts A's accumulation.
+    pub fn set_accumulate(&mut self, accumulate: crate::render::renderer::Accumulate) -> Result<()> {
+        if accumulate == self.renderer.accumulate() {
+            return Ok(());
+        }
+        self.renderer.set_accumulate(accumulate)?;
+        self.progressive.restart();
+        self.changed_at = Instant::now();
+        self.first_pass_after_change = None;
+        Ok(())
+    }
+
+    /// A's samples (B's may lag in a split): what A's views are made of.
+    pub fn a_samples(&self) -> u32 {
+        self.renderer.samples()
+    }
+
+    /// A's AOV layers, as `lookdev render --aov` computes them.
+    pub fn aov_layers(&self, aovs: &[crate::render::aov::Aov]) -> Result<Vec<crate::render::aov::Layer>> {
+        let sources = crate::render::aov::Sources {
+            gbuffer: &self.gbuffer,
+            look: self.document.look(),
+            renderer: &self.renderer,
+        };
+        crate::render::aov::layers(aovs, &sources)
+    }
+
+    /// A's linear radiance, as `read_radiance` gives it, with the display pixels shown again.
+    pub fn radiance(&mut self) -> Result<Vec<[f32; 4]>> {
+        let radiance = self.renderer.read_radiance()?;
+        let settings = self.document.settings();
+        self.renderer.finalize_rows(0, self.height(), settings.exposure, settings.tonemap)?;
+        Ok(radiance)
+    }
 }
 
 /// How a layer is named in the interface: its preset, or "custom".

@@ -19,6 +19,10 @@ pub const HOTKEYS: &[Hotkey] = &[
     Hotkey { keys: "Ctrl+Q", does: "Quit (asks about unsaved edits)" },
     Hotkey { keys: "F", does: "Fit the image to the view" },
     Hotkey { keys: "1", does: "Show the image at 1:1 (one image pixel per screen pixel)" },
+    Hotkey { keys: "C / Shift+C", does: "Next / previous view (beauty, light AOVs, parameters, N, V, masks, …)" },
+    Hotkey { keys: "M", does: "Back to the beauty" },
+    Hotkey { keys: "E", does: "False-colour EV view on or off" },
+    Hotkey { keys: "X", does: "Clipping overlay on or off" },
     Hotkey { keys: "?", does: "Show or hide this sheet" },
     Hotkey { keys: "Enter", does: "In a file dialog's name field: open or save that file" },
 ];

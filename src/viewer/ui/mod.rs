@@ -13,6 +13,7 @@ mod inspector;
 mod layers;
 mod lighting;
 mod viewport;
+mod views;
 
 pub use dialogs::{FileDialog, FilePurpose};
 pub use viewport::{ImagePlacement, MAX_SCALE, MIN_SCALE};
@@ -20,6 +21,7 @@ pub use viewport::{ImagePlacement, MAX_SCALE, MIN_SCALE};
 use super::action::Action;
 use super::session::Session;
 use super::thumbnails::Thumbnails;
+use super::view_image::Views;
 use egui::{Key, KeyboardShortcut, Modifiers};
 use std::time::{Duration, Instant};
 
@@ -55,6 +57,8 @@ pub struct Frame<'a> {
     pub compare_texture: Option<egui::TextureId>,
     pub pending: Option<&'a Pending>,
     pub figures: FrameFigures,
+    /// The view shown instead of the beauty, its copy and textures.
+    pub views: &'a Views,
 }
 
 /// The interface's own state: view, open windows, what is being typed.
@@ -112,11 +116,15 @@ impl Interface {
                 compare::show(ui, frame.session, &mut self.file_dialog, actions);
                 ui.separator();
                 inspector::show(ui, frame.session);
+                ui.separator();
+                views::histogram(ui, frame.views);
             })
         });
         egui::CentralPanel::no_frame().show(ui, |ui| {
-            self.placement =
-                Some(self.viewport.show(ui, frame.session, frame.view_texture, frame.compare_texture, actions));
+            // A view other than the beauty shows in A's place (B, in a split, keeps its beauty).
+            let a = frame.views.texture().unwrap_or(frame.view_texture);
+            self.placement = Some(self.viewport.show(ui, frame.session, a, frame.compare_texture, actions));
+            views::decorate(ui, frame.session, frame.views, self.viewport.image_rect);
         });
         let ctx = ui.ctx().clone();
         self.browser.show(&ctx, frame.session, thumbnails, actions, &mut self.message);
@@ -172,6 +180,7 @@ impl Interface {
             if input.consume_key(Modifiers::NONE, Key::Questionmark) {
                 self.hotkeys = !self.hotkeys;
             }
+            views::shortcuts(input, actions);
         });
     }
 
@@ -228,6 +237,8 @@ impl Interface {
                 if ui.add(egui::Button::new("Actual pixels (1:1)").shortcut_text("1")).clicked() {
                     self.viewport.actual_pixels();
                 }
+                ui.separator();
+                views::menu(ui, frame.session, frame.views, actions);
             });
             ui.menu_button("Help", |ui| {
                 if ui.add(egui::Button::new("Hotkeys").shortcut_text("?")).clicked() {
@@ -263,6 +274,8 @@ impl Interface {
             }
             ui.separator();
             ui.label(format!("{}×{} · {}", session.width(), session.height(), session.device_name()));
+            ui.separator();
+            ui.label(views::status(frame.views, self.viewport.hovered));
             if let Some(message) = &self.message {
                 if message.since.elapsed() < MESSAGE_TIME || message.error {
                     ui.separator();

@@ -22,6 +22,10 @@ pub struct Viewport {
     rotating: Option<(f32, f32)>,
     /// The A/B split's divider is being dragged.
     dividing: bool,
+    /// Where the image was drawn last, in points.
+    pub image_rect: Option<Rect>,
+    /// The image pixel under the pointer, while it hovers over the image.
+    pub hovered: Option<(u32, u32)>,
 }
 
 /// How near the divider (in points) a drag grabs it rather than panning.
@@ -111,6 +115,11 @@ impl Viewport {
             }
         }
         self.overlay(ui, &response, &painter, rect, image_rect, scale, (w, h), rotation);
+        self.image_rect = Some(image_rect);
+        self.hovered = response.hover_pos().and_then(|p| pixel_at(p, image_rect, w, h));
+        if let Some(inspection) = &session.inspection {
+            crosshair(&painter, rect, image_rect, (inspection.x, inspection.y), (w, h));
+        }
         if let (Some((_, column)), Some(labels)) = (split, session.compare_labels()) {
             split_overlay(&painter, image_rect, image_rect.min.x + image_rect.width() * column as f32 / w, labels);
         }
@@ -256,6 +265,25 @@ fn split_overlay(painter: &egui::Painter, image_rect: Rect, x: f32, (a, b): (Str
     };
     plate(a, pos2(x - 2.0, image_rect.min.y + 2.0), egui::Align2::RIGHT_TOP);
     plate(b, pos2(x + 2.0, image_rect.min.y + 2.0), egui::Align2::LEFT_TOP);
+}
+
+/// Marks the picked pixel with a crosshair whose arms run along its row and column up to the
+/// image's edge but never over the image, so the pixels stay as rendered; where the image fills
+/// the view on an axis, short ticks at the view's edges stand in for those arms.
+fn crosshair(painter: &egui::Painter, view: Rect, image: Rect, (x, y): (u32, u32), (w, h): (f32, f32)) {
+    let centre = image.min + vec2((x as f32 + 0.5) / w * image.width(), (y as f32 + 0.5) / h * image.height());
+    let stroke = egui::Stroke::new(1.0, Color32::from_rgb(255, 210, 0));
+    const TICK: f32 = 10.0;
+    let (top, bottom) = (image.min.y.max(view.min.y + TICK), image.max.y.min(view.max.y - TICK));
+    let (left, right) = (image.min.x.max(view.min.x + TICK), image.max.x.min(view.max.x - TICK));
+    if view.x_range().contains(centre.x) {
+        painter.line_segment([pos2(centre.x, view.min.y), pos2(centre.x, top)], stroke);
+        painter.line_segment([pos2(centre.x, bottom), pos2(centre.x, view.max.y)], stroke);
+    }
+    if view.y_range().contains(centre.y) {
+        painter.line_segment([pos2(view.min.x, centre.y), pos2(left, centre.y)], stroke);
+        painter.line_segment([pos2(right, centre.y), pos2(view.max.x, centre.y)], stroke);
+    }
 }
 
 /// The image pixel under window point `p`, if it is on the image.
