@@ -65,6 +65,12 @@ pub enum Action {
     Key(egui::Key, egui::Modifiers),
     /// Sets the zoom: `None` fits the image to the view, else window pixels per image pixel.
     Zoom(Option<f32>),
+    /// Snapshots the image with its look (`None`: the next `snapshot-N` name).
+    Snapshot(Option<String>),
+    /// Restores a snapshot's look and settings, as one undoable edit.
+    RestoreSnapshot(String),
+    /// Deletes a snapshot and its files.
+    DeleteSnapshot(String),
 }
 
 /// What to show as B, beside the edited look (A).
@@ -78,6 +84,8 @@ pub enum Compare {
     Swap,
     /// Back to the plain image.
     Off,
+    /// A snapshot, shown as a split, side by side, or as a ΔE heat map.
+    Snapshot(String, super::compare::SnapshotView),
 }
 
 /// What to do with unsaved edits before they would be lost.

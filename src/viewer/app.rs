@@ -284,6 +284,9 @@ impl Running {
         for (origin, action) in std::mem::take(&mut self.queue) {
             self.perform(origin, action)?;
         }
+        if let Some(warnings) = self.session.follow_look_file() {
+            self.list_snapshots(warnings);
+        }
         if let Err(e) = self.session.sync() {
             // Keep the renderer and the document in agreement: take the change back.
             self.session.document.undo();
@@ -293,6 +296,7 @@ impl Running {
         if !finishing {
             self.session.step()?;
         }
+        self.session.refresh_delta_e()?;
         self.update_title();
         let capture = finishing || !self.screenshots.is_empty();
         let captured = self.gui.draw(&mut self.presenter, output, capture)?;
@@ -465,6 +469,20 @@ impl Running {
             }
             Action::Key(key, modifiers) => self.gui.press_key(key, modifiers),
             Action::Zoom(scale) => self.interface.viewport.zoom_to(scale),
+            Action::Snapshot(name) => {
+                let name = self.session.take_snapshot(name.as_deref())?;
+                let spp = self.session.snapshots.get(&name)?.spp;
+                return Ok(Some(format!("snapshot {name} taken ({spp} spp)")));
+            }
+            Action::RestoreSnapshot(name) => {
+                let edit = self.session.restore_edit(&name)?;
+                self.session.document.apply(edit).map_err(Error::input)?;
+                return Ok(Some(format!("restored the look of snapshot {name} (undo brings back the previous one)")));
+            }
+            Action::DeleteSnapshot(name) => {
+                self.session.delete_snapshot(&name)?;
+                return Ok(Some(format!("deleted snapshot {name}")));
+            }
             Action::Answer(answer) => {
                 let pending = self.pending.take().ok_or_else(|| Error::input("there is no question to answer"))?;
                 match answer {
@@ -494,6 +512,7 @@ impl Running {
             }
             Compare::Look(path) => self.session.compare_look(&path)?,
             Compare::Off => self.session.compare_off(),
+            Compare::Snapshot(name, view) => self.session.compare_snapshot(&name, view)?,
             Compare::Swap => match self.session.compare_subject().map(|s| s.look_path().map(Path::to_path_buf)) {
                 None => return Err(Error::input("swap: nothing is being compared")),
                 Some(None) => self.session.swap_models()?,
@@ -556,6 +575,7 @@ impl Running {
             if let (Some(column), Some((a, b))) = (self.session.split_column(), self.session.compare_labels()) {
                 placement += &format!("; split at image column {column} ({a} | {b})");
             }
+            placement += &self.snapshot_report();
             println!(
                 "lookdev: screenshot {} ({}x{} window, {} spp{placement})",
                 path.display(),
@@ -569,6 +589,38 @@ impl Running {
             self.quit = true;
         }
         Ok(())
+    }
+
+    /// Says which snapshots the look has (when it has any) and which could not be read.
+    fn list_snapshots(&mut self, warnings: Vec<String>) {
+        let snapshots = &self.session.snapshots;
+        if let (Some(file), false) = (snapshots.look_file(), snapshots.list.is_empty()) {
+            let list: Vec<String> =
+                snapshots.list.iter().map(|s| format!("{} ({} spp, {})", s.name, s.spp, s.taken)).collect();
+            let name = file.file_name().map_or(file.display().to_string(), |n| n.to_string_lossy().into_owned());
+            println!("lookdev: snapshots of {name}: {}", list.join(", "));
+        }
+        for warning in warnings {
+            crate::warn(&warning);
+            self.interface.tell(warning, true);
+        }
+    }
+
+    /// What a screenshot shows of a snapshot beside the live image: where the side-by-side
+    /// snapshot is, and the ΔE figures.
+    fn snapshot_report(&self) -> String {
+        let Some(shown) = self.session.snapshot_compare() else { return String::new() };
+        let mut report = String::new();
+        if let Some((x, y)) = self.interface.placement.and_then(|p| p.second) {
+            report += &format!("; snapshot {} is at {x},{y}", shown.name);
+        }
+        if let (Some(delta), Some(samples)) = (&shown.delta, self.session.delta_e_samples()) {
+            report += &format!(
+                "; ΔE2000 live ({samples} spp) vs snapshot {}: mean {:.4} max {:.4}",
+                shown.name, delta.mean, delta.max
+            );
+        }
+        report
     }
 
     /// The figures a headless run ends with.

@@ -11,6 +11,7 @@ mod dialogs;
 mod inspector;
 mod layers;
 mod lighting;
+mod snapshots;
 mod viewport;
 
 pub use dialogs::{FileDialog, FilePurpose};
@@ -66,6 +67,7 @@ pub struct Interface {
     pub message: Option<Message>,
     /// Where the image was drawn last frame, in window pixels.
     pub placement: Option<ImagePlacement>,
+    snapshots: snapshots::Panel,
 }
 
 impl Interface {
@@ -89,6 +91,7 @@ impl Interface {
     /// Lays out and runs one frame of the interface.
     pub fn show(&mut self, ui: &mut egui::Ui, frame: &Frame, thumbnails: &mut Thumbnails, actions: &mut Vec<Action>) {
         self.shortcuts(ui.ctx(), frame, actions);
+        self.snapshots.prepare(ui.ctx(), frame.session);
         egui::Panel::top("menu").show(ui, |ui| self.menu(ui, frame, actions));
         egui::Panel::bottom("status").show(ui, |ui| self.status(ui, frame));
         // Each side panel scrolls what does not fit, both ways, rather than growing with its
@@ -109,11 +112,16 @@ impl Interface {
                 compare::show(ui, frame.session, &mut self.file_dialog, actions);
                 ui.separator();
                 inspector::show(ui, frame.session);
+                ui.separator();
+                self.snapshots.show(ui, frame.session, actions);
             })
         });
+        let snapshot = self.snapshots.shown(frame.session);
+        // A snapshot split shows the snapshot's image as B.
+        let compare = snapshot.as_ref().map_or(frame.compare_texture, |s| Some(s.texture));
         egui::CentralPanel::no_frame().show(ui, |ui| {
-            self.placement =
-                Some(self.viewport.show(ui, frame.session, frame.view_texture, frame.compare_texture, actions));
+            let placement = self.viewport.show(ui, frame.session, frame.view_texture, compare, snapshot.as_ref(), actions);
+            self.placement = Some(placement);
         });
         let ctx = ui.ctx().clone();
         self.browser.show(&ctx, frame.session, thumbnails, actions, &mut self.message);
@@ -165,6 +173,9 @@ impl Interface {
             if input.consume_key(Modifiers::NONE, Key::Num1) {
                 self.viewport.actual_pixels();
             }
+            if input.consume_key(Modifiers::NONE, Key::P) {
+                actions.push(Action::Snapshot(None));
+            }
         });
     }
 
@@ -212,6 +223,12 @@ impl Interface {
                 ui.separator();
                 if ui.button("Add layer from library…").clicked() {
                     self.browser.open = true;
+                }
+                ui.separator();
+                let has_file = document.path().is_some();
+                let snapshot = egui::Button::new("Take snapshot").shortcut_text("P");
+                if ui.add_enabled(has_file, snapshot).on_disabled_hover_text("Save the look first").clicked() {
+                    actions.push(Action::Snapshot(None));
                 }
             });
             ui.menu_button("View", |ui| {
