@@ -42,7 +42,7 @@ fn canonical_look(case: &Case) -> String {
 }
 
 /// The report line of screenshot `name`.
-fn report<'a>(output: &'a Output, name: &str) -> String {
+fn report(output: &Output, name: &str) -> String {
     let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
     stdout
         .lines()
@@ -127,7 +127,8 @@ fn snapshot_edit_compare_restore_round_trips_the_look_and_a_second_run_finds_it(
     let args = ["render", "--gbuffer", "g.exr", "--look", "look.toml", "--spp", "4", "--quiet", "--out", "before.exr"];
     assert_success(&case.command(&args).output().unwrap());
     let (snapshot, render) = (exr_pixels(&folder.join("before.exr")), exr_pixels(&case.path("before.exr")));
-    let worst = snapshot.iter().zip(&render).flat_map(|(a, b)| (0..4).map(move |k| (a[k] - b[k]).abs())).fold(0.0, f32::max);
+    let worst =
+        snapshot.iter().zip(&render).flat_map(|(a, b)| (0..4).map(move |k| (a[k] - b[k]).abs())).fold(0.0, f32::max);
     assert!(worst < 1e-4, "the snapshot's radiance is the render's: largest difference {worst}");
     let png = image::open(folder.join("before.png")).unwrap().into_rgb8();
     assert_matches_render(&png, &rendered);
@@ -157,7 +158,7 @@ fn snapshot_edit_compare_restore_round_trips_the_look_and_a_second_run_finds_it(
     // Side by side: each whole image, the live one where the image is, the snapshot beside it.
     let line = report(&output, "side.png");
     let at = line.split("; snapshot before is at ").nth(1).expect("the snapshot's place is reported");
-    let (x, y) = at.split(';').next().unwrap().split_once(',').unwrap();
+    let (x, y) = at.split([';', ')']).next().unwrap().split_once(',').unwrap();
     let (x, y): (u32, u32) = (x.parse().unwrap(), y.trim().parse().unwrap());
     let window = image::open(case.path("side.png")).unwrap().into_rgb8();
     assert_matches_render(&case.screenshot_image(&output, "side.png"), &edited_render);
@@ -231,7 +232,10 @@ fn snapshot_problems_are_clear_errors_and_a_corrupt_file_is_a_warning() {
     let text = stderr(&output);
     assert!(text.contains("warning: ") && text.contains("broken.toml:1: TOML syntax error"), "{text}");
     assert!(text.contains("lost.png: file not found; this snapshot is skipped"), "{text}");
-    assert!(text.contains("missing.script:2: no snapshot named 'bigg' (did you mean 'big'?); there are: big"), "{text}");
+    assert!(
+        text.contains("missing.script:2: no snapshot named 'bigg' (did you mean 'big'?); there are: big"),
+        "{text}"
+    );
     assert!(!text.contains("panicked"), "{text}");
 
     // Another g-buffer's snapshot cannot be compared; a name in use cannot be taken again.

@@ -38,7 +38,11 @@ impl DeltaE {
             .map(|(p, q)| if p[..3] == q[..3] { 0.0 } else { ciede2000(lab(p), lab(q)) as f32 })
             .collect();
         let max = values.iter().copied().fold(0.0, f32::max);
-        let mean = if values.is_empty() { 0.0 } else { (values.iter().map(|&v| v as f64).sum::<f64>() / values.len() as f64) as f32 };
+        let mean = if values.is_empty() {
+            0.0
+        } else {
+            (values.iter().map(|&v| v as f64).sum::<f64>() / values.len() as f64) as f32
+        };
         static MADE: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
         let serial = MADE.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         DeltaE { width, height, values, mean, max, serial }
@@ -46,10 +50,13 @@ impl DeltaE {
 
     /// The heat map as RGBA8 sRGB pixels (see [`STOPS`]).
     pub fn heat_map(&self) -> Vec<u8> {
-        self.values.iter().flat_map(|&v| {
-            let [r, g, b] = heat(v);
-            [r, g, b, 255]
-        }).collect()
+        self.values
+            .iter()
+            .flat_map(|&v| {
+                let [r, g, b] = heat(v);
+                [r, g, b, 255]
+            })
+            .collect()
     }
 }
 
@@ -134,7 +141,8 @@ pub fn ciede2000([l1, a1, b1]: [f64; 3], [l2, a2, b2]: [f64; 3]) -> f64 {
     } else {
         (h1p + h2p - 360.0) / 2.0
     };
-    let t = 1.0 - 0.17 * rad(hp_mean - 30.0).cos() + 0.24 * rad(2.0 * hp_mean).cos()
+    let t = 1.0 - 0.17 * rad(hp_mean - 30.0).cos()
+        + 0.24 * rad(2.0 * hp_mean).cos()
         + 0.32 * rad(3.0 * hp_mean + 6.0).cos()
         - 0.20 * rad(4.0 * hp_mean - 63.0).cos();
     let d_theta = 30.0 * (-((hp_mean - 275.0) / 25.0).powi(2)).exp();

@@ -280,7 +280,8 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
             Ok(Step::Do(Action::Answer(answer)))
         }
         "compare" => {
-            let usage = "'compare' takes `model KEY=VALUE...`, `look FILE`, `snapshot NAME [split|side|delta-e]`, `swap` \
+            let usage =
+                "'compare' takes `model KEY=VALUE...`, `look FILE`, `snapshot NAME [split|side|delta-e]`, `swap` \
                 or `off`";
             let (what, more) = rest.split_once(char::is_whitespace).unwrap_or((rest, ""));
             let more = more.trim();
@@ -348,7 +349,11 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
             arity(1)?;
             crate::viewer::snapshots::check_name(args[0])?;
             let name = args[0].to_string();
-            Ok(Step::Do(if command == "restore" { Action::RestoreSnapshot(name) } else { Action::DeleteSnapshot(name) }))
+            Ok(Step::Do(if command == "restore" {
+                Action::RestoreSnapshot(name)
+            } else {
+                Action::DeleteSnapshot(name)
+            }))
         }
         other => Err(format!("unknown command '{other}' (expected one of: {COMMANDS})")),
     }
@@ -505,10 +510,11 @@ mod tests {
 
     #[test]
     fn snapshot_commands_parse_and_bad_names_are_refused_at_their_line() {
-        let script =
-            parse("snapshot\nsnapshot before\nrestore before\ncompare snapshot before delta-e\ncompare snapshot a side\n\
-                   compare snapshot b\ndelete-snapshot b\n")
-                .unwrap();
+        let script = parse(
+            "snapshot\nsnapshot before\nrestore before\ncompare snapshot before delta-e\ncompare snapshot a side\n\
+                   compare snapshot b\ndelete-snapshot b\n",
+        )
+        .unwrap();
         let steps: Vec<&Step> = script.steps.iter().map(|(_, s)| s).collect();
         assert_eq!(*steps[0], Step::Do(Action::Snapshot(None)));
         assert_eq!(*steps[1], Step::Do(Action::Snapshot(Some("before".into()))));

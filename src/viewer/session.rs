@@ -5,8 +5,8 @@
 
 use super::compare::{self, Compare, SnapshotView, Subject};
 use super::delta_e::DeltaE;
-use super::snapshots::{Capture, Snapshots};
 use super::progressive::{Progressive, FRAME_BUDGET};
+use super::snapshots::{Capture, Snapshots};
 use crate::environment::{self, Environment, LoadOptions};
 use crate::gbuffer::GBuffer;
 use crate::gpu::{Context, Image};

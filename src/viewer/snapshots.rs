@@ -154,8 +154,13 @@ impl Snapshots {
     pub fn get(&self, name: &str) -> Result<&Snapshot> {
         self.list.iter().find(|s| s.name == name).ok_or_else(|| {
             let names: Vec<&str> = self.list.iter().map(|s| s.name.as_str()).collect();
-            let has = if names.is_empty() { "there are none".to_string() } else { format!("there are: {}", names.join(", ")) };
-            let hint = crate::suggest::near_miss(name, &names).map_or(String::new(), |n| format!(" (did you mean '{n}'?)"));
+            let has = if names.is_empty() {
+                "there are none".to_string()
+            } else {
+                format!("there are: {}", names.join(", "))
+            };
+            let hint =
+                crate::suggest::near_miss(name, &names).map_or(String::new(), |n| format!(" (did you mean '{n}'?)"));
             Error::input(format!("no snapshot named '{}'{hint}; {has}", crate::printable(name)))
         })
     }
@@ -171,26 +176,51 @@ impl Snapshots {
         let name = name.map_or_else(|| self.default_name(), str::to_string);
         check_name(&name).map_err(Error::input)?;
         if self.list.iter().any(|s| s.name == name) {
-            return Err(Error::input(format!("a snapshot named '{name}' already exists (delete it, or choose another name)")));
+            return Err(Error::input(format!(
+                "a snapshot named '{name}' already exists (delete it, or choose another name)"
+            )));
         }
         Ok(name)
     }
 
     /// Writes a snapshot of `capture` under `name` (from [`Snapshots::name_for_new`]), with the
     /// look and settings that made it, and lists it.
-    pub fn add(&mut self, name: String, look: &Look, settings: &Settings, capture: Capture, size: (u32, u32)) -> Result<&Snapshot> {
+    pub fn add(
+        &mut self,
+        name: String,
+        look: &Look,
+        settings: &Settings,
+        capture: Capture,
+        size: (u32, u32),
+    ) -> Result<&Snapshot> {
         let look_file = self.look.clone().ok_or_else(|| Error::input("snapshot: the look has no file yet"))?;
         let folder = folder_for(&look_file);
-        std::fs::create_dir_all(&folder).map_err(|e| Error::io(&folder, format!("cannot create the snapshot folder ({e})")))?;
+        std::fs::create_dir_all(&folder)
+            .map_err(|e| Error::io(&folder, format!("cannot create the snapshot folder ({e})")))?;
         let (width, height) = size;
         let path = |ext: &str| folder.join(format!("{name}.{ext}"));
-        output::write_exr_with(&path("exr"), width, height, &capture.radiance, capture.background, &[], &capture.metadata)?;
+        output::write_exr_with(
+            &path("exr"),
+            width,
+            height,
+            &capture.radiance,
+            capture.background,
+            &[],
+            &capture.metadata,
+        )?;
         output::write_png(&path("png"), width, height, &capture.display, !capture.background)?;
         // The look as saving it would write it: relative references stay relative to its folder.
         let mut stored = look.clone();
         stored.file = Some(look_file.clone());
         let taken = utc_now();
-        let header = Header { name: name.clone(), spp: capture.spp, taken: taken.clone(), width, height, look: stored.to_toml() };
+        let header = Header {
+            name: name.clone(),
+            spp: capture.spp,
+            taken: taken.clone(),
+            width,
+            height,
+            look: stored.to_toml(),
+        };
         let text = toml::to_string(&SnapshotFile { snapshot: header })
             .map_err(|e| Error::io(path("toml"), format!("cannot encode the snapshot ({e})")))?;
         let text = format!("# A lookdev viewer snapshot (docs/formats.md#snapshots).\n{text}");
@@ -237,17 +267,24 @@ fn read(file: &Path, look_file: &Path, id: u64) -> Result<Snapshot> {
     let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     check_name(&stem).map_err(|problem| Error::input_file(file, problem))?;
     if header.name != stem {
-        return Err(Error::input_file(file, format!("names the snapshot '{}', but the file is {stem}.toml", crate::printable(&header.name))));
+        return Err(Error::input_file(
+            file,
+            format!("names the snapshot '{}', but the file is {stem}.toml", crate::printable(&header.name)),
+        ));
     }
     let side = input::exr::MAX_SIDE as u32;
     if header.width == 0 || header.height == 0 || header.width > side || header.height > side {
-        return Err(Error::input_file(file, format!("the size {}x{} is not an image size", header.width, header.height)));
+        return Err(Error::input_file(
+            file,
+            format!("the size {}x{} is not an image size", header.width, header.height),
+        ));
     }
     if header.spp == 0 {
         return Err(Error::input_file(file, "spp = 0: a snapshot has at least one sample"));
     }
     let look = Look::parse(&header.look, look_file).map_err(|e| Error::input_file(file, format!("its look: {e}")))?;
-    let settings = Settings::resolve(&look, &Overrides::default()).map_err(|e| Error::input_file(file, format!("its look: {e}")))?;
+    let settings = Settings::resolve(&look, &Overrides::default())
+        .map_err(|e| Error::input_file(file, format!("its look: {e}")))?;
     let exr = file.with_extension("exr");
     if !std::fs::metadata(&exr).is_ok_and(|m| m.is_file()) {
         return Err(Error::input_file(&exr, "missing: the snapshot's radiance is not there"));
@@ -258,7 +295,13 @@ fn read(file: &Path, look_file: &Path, id: u64) -> Result<Snapshot> {
     if (image.width(), image.height()) != (header.width, header.height) {
         return Err(Error::input_file(
             &png,
-            format!("is {}x{}, but the snapshot says {}x{}", image.width(), image.height(), header.width, header.height),
+            format!(
+                "is {}x{}, but the snapshot says {}x{}",
+                image.width(),
+                image.height(),
+                header.width,
+                header.height
+            ),
         ));
     }
     Ok(Snapshot {
@@ -266,7 +309,7 @@ fn read(file: &Path, look_file: &Path, id: u64) -> Result<Snapshot> {
         look,
         settings,
         spp: header.spp,
-        taken: header.taken,
+        taken: crate::printable(&header.taken),
         width: header.width,
         height: header.height,
         display: image.into_rgba8().into_raw(),
@@ -345,7 +388,10 @@ mod tests {
         snapshots.list = vec![blank("snapshot-1"), blank("snapshot-7"), blank("mine")];
         assert_eq!(snapshots.default_name(), "snapshot-8");
         let missing = snapshots.get("snapshot-2").unwrap_err().to_string();
-        assert!(missing.contains("no snapshot named 'snapshot-2'") && missing.contains("snapshot-1, snapshot-7, mine"), "{missing}");
+        assert!(
+            missing.contains("no snapshot named 'snapshot-2'") && missing.contains("snapshot-1, snapshot-7, mine"),
+            "{missing}"
+        );
         let refused = snapshots.name_for_new(None).unwrap_err().to_string();
         assert!(refused.contains("the look has no file yet"), "{refused}");
     }

@@ -120,7 +120,8 @@ impl Interface {
         // A snapshot split shows the snapshot's image as B.
         let compare = snapshot.as_ref().map_or(frame.compare_texture, |s| Some(s.texture));
         egui::CentralPanel::no_frame().show(ui, |ui| {
-            let placement = self.viewport.show(ui, frame.session, frame.view_texture, compare, snapshot.as_ref(), actions);
+            let placement =
+                self.viewport.show(ui, frame.session, frame.view_texture, compare, snapshot.as_ref(), actions);
             self.placement = Some(placement);
         });
         let ctx = ui.ctx().clone();

@@ -41,7 +41,8 @@ impl Panel {
             if !self.textures.iter().any(|(id, _)| *id == snapshot.id) {
                 let size = [snapshot.width as usize, snapshot.height as usize];
                 let image = egui::ColorImage::from_rgba_unmultiplied(size, &snapshot.display);
-                let texture = ctx.load_texture(format!("snapshot-{}", snapshot.id), image, egui::TextureOptions::NEAREST);
+                let texture =
+                    ctx.load_texture(format!("snapshot-{}", snapshot.id), image, egui::TextureOptions::NEAREST);
                 self.textures.push((snapshot.id, texture));
             }
         }
@@ -89,13 +90,21 @@ impl Panel {
             ui.weak("Save the look to keep snapshots beside it.");
             return;
         }
+        let compared = session.snapshot_compare();
+        // While comparing, the choice shows and changes how the snapshot is shown.
+        if let Some(compare) = compared {
+            self.view = compare.view;
+        }
         ui.horizontal(|ui| {
             ui.label("Compare as");
             for view in SnapshotView::ALL {
-                ui.selectable_value(&mut self.view, view, view.label());
+                if ui.selectable_value(&mut self.view, view, view.label()).clicked() {
+                    if let Some(compare) = compared.filter(|c| c.view != view) {
+                        actions.push(Action::Compare(Compare::Snapshot(compare.name.clone(), view)));
+                    }
+                }
             }
         });
-        let compared = session.snapshot_compare();
         if let Some(compare) = compared {
             ui.horizontal(|ui| {
                 ui.label(format!("B: {} ({})", compare.name, compare.view.label()));
@@ -105,6 +114,13 @@ impl Panel {
             });
             if let Some(delta) = &compare.delta {
                 ui.label(format!("ΔE2000 mean {:.2}, max {:.2}", delta.mean, delta.max));
+            }
+            if compare.view == SnapshotView::Split {
+                let mut divider = session.divider;
+                let slider = egui::Slider::new(&mut divider, 0.0..=1.0).text("divider").max_decimals(3);
+                if ui.add(slider).changed() {
+                    actions.push(Action::Divider(divider));
+                }
             }
         }
         if session.snapshots.list.is_empty() {

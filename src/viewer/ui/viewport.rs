@@ -288,7 +288,8 @@ fn side_labels(painter: &egui::Painter, a_rect: Rect, b_rect: Rect, (a, b): (Str
     let font = egui::FontId::proportional(12.0);
     for (text, rect) in [(a, a_rect), (b, b_rect)] {
         let galley = painter.layout_no_wrap(text, font.clone(), Color32::WHITE);
-        let plate = egui::Align2::LEFT_BOTTOM.anchor_size(rect.left_top() - vec2(0.0, 2.0), galley.size() + vec2(8.0, 6.0));
+        let plate =
+            egui::Align2::LEFT_BOTTOM.anchor_size(rect.left_top() - vec2(0.0, 2.0), galley.size() + vec2(8.0, 6.0));
         painter.rect_filled(plate, 2.0, Color32::from_black_alpha(170));
         painter.galley(plate.min + vec2(4.0, 3.0), galley, Color32::WHITE);
     }
@@ -302,7 +303,7 @@ fn delta_e_legend(painter: &egui::Painter, view: Rect, shown: &super::snapshots:
     let top_left = view.left_top() + vec2(10.0, 10.0);
     let (width, height) = (200.0, 12.0);
     let top = STOPS[STOPS.len() - 1].0;
-    let plate = Rect::from_min_size(top_left - vec2(6.0, 6.0), vec2(width + 12.0, 62.0));
+    let plate = Rect::from_min_size(top_left - vec2(6.0, 6.0), vec2(width + 28.0, 54.0));
     painter.rect_filled(plate, 3.0, Color32::from_black_alpha(190));
     let title = match shown.delta {
         Some((mean, max)) => format!("ΔE2000 vs {}: mean {mean:.2}, max {max:.2}", shown.name),
