@@ -225,15 +225,16 @@ fn snapshot_problems_are_clear_errors_and_a_corrupt_file_is_a_warning() {
     case.write("look.snapshots/lost.toml", &header("lost", SIZE));
     std::fs::write(folder.join("lost.exr"), b"").unwrap();
 
-    // Listed with warnings, and the viewer opens; a missing snapshot is named with those there are.
-    case.write("missing.script", "wait-spp 1\nrestore bigg\n");
+    // Listed with warnings, and the viewer opens; a missing snapshot is named with those there
+    // are, which are listed before the first line runs.
+    case.write("missing.script", "restore bigg\n");
     let output = case.view(&["look.toml", "--script", "missing.script", "--exit-after-spp", "1"]);
     assert_eq!(output.status.code(), Some(2), "{}", stderr(&output));
     let text = stderr(&output);
     assert!(text.contains("warning: ") && text.contains("broken.toml:1: TOML syntax error"), "{text}");
     assert!(text.contains("lost.png: file not found; this snapshot is skipped"), "{text}");
     assert!(
-        text.contains("missing.script:2: no snapshot named 'bigg' (did you mean 'big'?); there are: big"),
+        text.contains("missing.script:1: no snapshot named 'bigg' (did you mean 'big'?); there are: big"),
         "{text}"
     );
     assert!(!text.contains("panicked"), "{text}");

@@ -256,6 +256,8 @@ impl Running {
     fn redraw(&mut self) -> Result<()> {
         let started = Instant::now();
         let finishing = self.headless_done();
+        // Before the frame's actions too, so that the first one finds the look's snapshots.
+        self.follow_look_file();
         if !finishing {
             self.script_step()?;
         }
@@ -284,9 +286,7 @@ impl Running {
         for (origin, action) in std::mem::take(&mut self.queue) {
             self.perform(origin, action)?;
         }
-        if let Some(warnings) = self.session.follow_look_file() {
-            self.list_snapshots(warnings);
-        }
+        self.follow_look_file();
         if let Err(e) = self.session.sync() {
             // Keep the renderer and the document in agreement: take the change back.
             self.session.document.undo();
@@ -591,8 +591,10 @@ impl Running {
         Ok(())
     }
 
-    /// Says which snapshots the look has (when it has any) and which could not be read.
-    fn list_snapshots(&mut self, warnings: Vec<String>) {
+    /// Lists the snapshots of the look's file, when that file changed (see
+    /// [`Session::follow_look_file`]): says which there are and which could not be read.
+    fn follow_look_file(&mut self) {
+        let Some(warnings) = self.session.follow_look_file() else { return };
         let snapshots = &self.session.snapshots;
         if let (Some(file), false) = (snapshots.look_file(), snapshots.list.is_empty()) {
             let list: Vec<String> =
