@@ -32,11 +32,24 @@ impl DeltaE {
     pub fn between(width: u32, height: u32, a: &[u8], b: &[u8]) -> DeltaE {
         let table = decode_table();
         let lab = |p: &[u8]| srgb8_to_lab(&table, [p[0], p[1], p[2]]);
-        let values: Vec<f32> = a
-            .chunks_exact(4)
-            .zip(b.chunks_exact(4))
-            .map(|(p, q)| if p[..3] == q[..3] { 0.0 } else { ciede2000(lab(p), lab(q)) as f32 })
-            .collect();
+        let pixels = a.len().min(b.len()) / 4;
+        let mut values = vec![0.0f32; pixels];
+        // A band of pixels per core: at 1024² the map is a fraction of a frame's wait rather
+        // than several frames. Each pixel is independent, so the bands do not change the result.
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, 16);
+        let band = pixels.div_ceil(threads).max(1);
+        std::thread::scope(|scope| {
+            for (index, out) in values.chunks_mut(band).enumerate() {
+                let (a, b) = (&a[index * band * 4..], &b[index * band * 4..]);
+                scope.spawn(move || {
+                    for ((value, p), q) in out.iter_mut().zip(a.chunks_exact(4)).zip(b.chunks_exact(4)) {
+                        if p[..3] != q[..3] {
+                            *value = ciede2000(lab(p), lab(q)) as f32;
+                        }
+                    }
+                });
+            }
+        });
         let max = values.iter().copied().fold(0.0, f32::max);
         let mean = if values.is_empty() {
             0.0
@@ -219,6 +232,20 @@ mod tests {
         assert!(changed.values[5] > 1.0 && changed.max == changed.values[5], "{:?}", changed.values);
         assert!((changed.mean - changed.max / 16.0).abs() < 1e-6);
         assert!(changed.values.iter().enumerate().all(|(i, &v)| i == 5 || v == 0.0));
+    }
+
+    #[test]
+    fn every_pixel_is_its_own_difference_whatever_the_bands() {
+        let (width, height) = (37u32, 23u32);
+        let a: Vec<u8> = (0..width * height * 4).map(|i| (i * 7 % 251) as u8).collect();
+        let b: Vec<u8> = (0..width * height * 4).map(|i| (i * 13 % 241) as u8).collect();
+        let map = DeltaE::between(width, height, &a, &b);
+        let table = decode_table();
+        let lab = |p: &[u8]| srgb8_to_lab(&table, [p[0], p[1], p[2]]);
+        assert_eq!(map.values.len(), (width * height) as usize);
+        for (i, (p, q)) in a.chunks_exact(4).zip(b.chunks_exact(4)).enumerate() {
+            assert_eq!(map.values[i], ciede2000(lab(p), lab(q)) as f32, "pixel {i}");
+        }
     }
 
     #[test]
