@@ -37,6 +37,8 @@ pub enum Kind {
     GBuffer,
     /// An environment map (OpenEXR or Radiance `.hdr`).
     Environment,
+    /// A viewer snapshot's display image (PNG).
+    SnapshotImage,
 }
 
 impl Kind {
@@ -50,6 +52,7 @@ impl Kind {
             Kind::Gltf | Kind::GltfResource => 2048 * MIB,
             Kind::GBuffer => 4096 * MIB,
             Kind::Environment => 2048 * MIB,
+            Kind::SnapshotImage => 1024 * MIB,
         }
     }
 
@@ -61,6 +64,7 @@ impl Kind {
             Kind::GltfResource => "a glTF buffer or image",
             Kind::GBuffer => "a g-buffer",
             Kind::Environment => "an environment",
+            Kind::SnapshotImage => "a snapshot image",
         }
     }
 }

@@ -6,7 +6,7 @@ pub mod params;
 pub mod physical;
 pub mod preset;
 pub mod stack;
-mod toml_input;
+pub(crate) mod toml_input;
 
 pub use look::Look;
 pub use params::{Param, Params, Value};

@@ -74,6 +74,12 @@ pub enum Action {
         x: u32,
         y: u32,
     },
+    /// Snapshots the image with its look (`None`: the next `snapshot-N` name).
+    Snapshot(Option<String>),
+    /// Restores a snapshot's look and settings, as one undoable edit.
+    RestoreSnapshot(String),
+    /// Deletes a snapshot and its files.
+    DeleteSnapshot(String),
 }
 
 /// What to show as B, beside the edited look (A).
@@ -87,6 +93,8 @@ pub enum Compare {
     Swap,
     /// Back to the plain image.
     Off,
+    /// A snapshot, shown as a split, side by side, or as a ΔE heat map.
+    Snapshot(String, super::compare::SnapshotView),
 }
 
 /// What to do with unsaved edits before they would be lost.

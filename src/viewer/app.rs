@@ -259,6 +259,8 @@ impl Running {
     fn redraw(&mut self) -> Result<()> {
         let started = Instant::now();
         let finishing = self.headless_done();
+        // Before the frame's actions too, so that the first one finds the look's snapshots.
+        self.follow_look_file();
         if !finishing {
             self.script_step()?;
         }
@@ -289,6 +291,7 @@ impl Running {
         for (origin, action) in std::mem::take(&mut self.queue) {
             self.perform(origin, action)?;
         }
+        self.follow_look_file();
         if let Err(e) = self.session.sync() {
             // Keep the renderer and the document in agreement: take the change back.
             self.session.document.undo();
@@ -298,6 +301,7 @@ impl Running {
         if !finishing {
             self.session.step()?;
         }
+        self.session.refresh_delta_e()?;
         self.update_title();
         let capture = finishing || !self.screenshots.is_empty();
         let captured = self.gui.draw(&mut self.presenter, output, capture)?;
@@ -477,6 +481,20 @@ impl Running {
                 println!("lookdev: {line}");
                 return Ok(Some(line));
             }
+            Action::Snapshot(name) => {
+                let name = self.session.take_snapshot(name.as_deref())?;
+                let spp = self.session.snapshots.get(&name)?.spp;
+                return Ok(Some(format!("snapshot {name} taken ({spp} spp)")));
+            }
+            Action::RestoreSnapshot(name) => {
+                let edit = self.session.restore_edit(&name)?;
+                self.session.document.apply(edit).map_err(Error::input)?;
+                return Ok(Some(format!("restored the look of snapshot {name} (undo brings back the previous one)")));
+            }
+            Action::DeleteSnapshot(name) => {
+                self.session.delete_snapshot(&name)?;
+                return Ok(Some(format!("deleted snapshot {name}")));
+            }
             Action::Answer(answer) => {
                 let pending = self.pending.take().ok_or_else(|| Error::input("there is no question to answer"))?;
                 match answer {
@@ -506,6 +524,7 @@ impl Running {
             }
             Compare::Look(path) => self.session.compare_look(&path)?,
             Compare::Off => self.session.compare_off(),
+            Compare::Snapshot(name, view) => self.session.compare_snapshot(&name, view)?,
             Compare::Swap => match self.session.compare_subject().map(|s| s.look_path().map(Path::to_path_buf)) {
                 None => return Err(Error::input("swap: nothing is being compared")),
                 Some(None) => self.session.swap_models()?,
@@ -568,6 +587,7 @@ impl Running {
             if let (Some(column), Some((a, b))) = (self.session.split_column(), self.session.compare_labels()) {
                 placement += &format!("; split at image column {column} ({a} | {b})");
             }
+            placement += &self.snapshot_report();
             println!(
                 "lookdev: screenshot {} ({}x{} window, {} spp{placement})",
                 path.display(),
@@ -581,6 +601,40 @@ impl Running {
             self.quit = true;
         }
         Ok(())
+    }
+
+    /// Lists the snapshots of the look's file, when that file changed (see
+    /// [`Session::follow_look_file`]): says which there are and which could not be read.
+    fn follow_look_file(&mut self) {
+        let Some(warnings) = self.session.follow_look_file() else { return };
+        let snapshots = &self.session.snapshots;
+        if let (Some(file), false) = (snapshots.look_file(), snapshots.list.is_empty()) {
+            let list: Vec<String> =
+                snapshots.list.iter().map(|s| format!("{} ({} spp, {})", s.name, s.spp, s.taken)).collect();
+            let name = file.file_name().map_or(file.display().to_string(), |n| n.to_string_lossy().into_owned());
+            println!("lookdev: snapshots of {name}: {}", list.join(", "));
+        }
+        for warning in warnings {
+            crate::warn(&warning);
+            self.interface.tell(warning, true);
+        }
+    }
+
+    /// What a screenshot shows of a snapshot beside the live image: where the side-by-side
+    /// snapshot is, and the ΔE figures.
+    fn snapshot_report(&self) -> String {
+        let Some(shown) = self.session.snapshot_compare() else { return String::new() };
+        let mut report = String::new();
+        if let Some((x, y)) = self.interface.placement.and_then(|p| p.second) {
+            report += &format!("; snapshot {} is at {x},{y}", shown.name);
+        }
+        if let (Some(delta), Some(samples)) = (&shown.delta, self.session.delta_e_samples()) {
+            report += &format!(
+                "; ΔE2000 live ({samples} spp) vs snapshot {}: mean {:.4} max {:.4}",
+                shown.name, delta.mean, delta.max
+            );
+        }
+        report
     }
 
     /// The figures a headless run ends with.

@@ -44,6 +44,46 @@ pub struct Compare {
     pub packed: PackedStacks,
 }
 
+/// How a snapshot is shown beside the live image.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SnapshotView {
+    /// The divider split, a wipe: live left of the divider, the snapshot right of it.
+    #[default]
+    Split,
+    /// Side by side: each whole image in half the view.
+    Side,
+    /// The CIEDE2000 difference of the display colours, as a heat map.
+    DeltaE,
+}
+
+impl SnapshotView {
+    pub const ALL: [SnapshotView; 3] = [SnapshotView::Split, SnapshotView::Side, SnapshotView::DeltaE];
+
+    /// The script's word for it.
+    pub fn name(self) -> &'static str {
+        match self {
+            SnapshotView::Split => "split",
+            SnapshotView::Side => "side",
+            SnapshotView::DeltaE => "delta-e",
+        }
+    }
+
+    pub fn label(self) -> &'static str {
+        match self {
+            SnapshotView::Split => "Split",
+            SnapshotView::Side => "Side by side",
+            SnapshotView::DeltaE => "ΔE2000",
+        }
+    }
+
+    pub fn parse(text: &str) -> Result<SnapshotView, String> {
+        SnapshotView::ALL
+            .into_iter()
+            .find(|v| v.name() == text)
+            .ok_or_else(|| format!("unknown snapshot view '{text}' (expected split, side or delta-e)"))
+    }
+}
+
 /// The image column where B starts, for a divider at `fraction` of an image `width` wide.
 pub fn split_column(fraction: f32, width: u32) -> u32 {
     ((fraction.clamp(0.0, 1.0) * width as f32).round() as u32).min(width)

@@ -14,11 +14,13 @@
 mod action;
 mod app;
 mod compare;
+mod delta_e;
 mod gui;
 mod presenter;
 mod progressive;
 mod script;
 mod session;
+mod snapshots;
 pub mod thumbnails;
 mod ui;
 mod view_image;

@@ -5,6 +5,7 @@
 //! viewer with the file and line named.
 
 use super::action::{Action, Answer, Compare};
+use super::compare::SnapshotView;
 use crate::material::params::{parse_value, Param, Value};
 use crate::shading::tonemap::Tonemap;
 use crate::viewer_state::{Edit, ObjectRef, Selection};
@@ -62,7 +63,8 @@ impl LayerChange {
 /// The commands, for the error that names an unknown one.
 const COMMANDS: &str = "select, set, reset, map, add, remove, duplicate, move, show, hide, mask, invert, opacity, \
     rotate, intensity, background, env, exposure, tonemap, spp, seed, undo, redo, pick, inspect, wait-spp, save-look, \
-    save-preset, save-image, screenshot, open-look, quit, answer, compare, divider, key, zoom, view, clipping, probe";
+    save-preset, save-image, screenshot, open-look, quit, answer, compare, divider, key, zoom, view, clipping, probe, \
+    snapshot, restore, delete-snapshot";
 
 impl Script {
     pub fn load(path: &Path) -> Result<Script> {
@@ -278,7 +280,9 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
             Ok(Step::Do(Action::Answer(answer)))
         }
         "compare" => {
-            let usage = "'compare' takes `model KEY=VALUE...`, `look FILE`, `swap` or `off`";
+            let usage =
+                "'compare' takes `model KEY=VALUE...`, `look FILE`, `snapshot NAME [split|side|delta-e]`, `swap` \
+                or `off`";
             let (what, more) = rest.split_once(char::is_whitespace).unwrap_or((rest, ""));
             let more = more.trim();
             let compare = match what {
@@ -296,6 +300,16 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
                 }
                 "look" if !more.is_empty() => Compare::Look(PathBuf::from(more)),
                 "look" => return Err("'compare look' needs a file".into()),
+                "snapshot" => {
+                    let words: Vec<&str> = more.split_whitespace().collect();
+                    let (name, view) = match words[..] {
+                        [name] => (name, SnapshotView::Split),
+                        [name, view] => (name, SnapshotView::parse(view)?),
+                        _ => return Err("'compare snapshot' takes a name and optionally split, side or delta-e".into()),
+                    };
+                    crate::viewer::snapshots::check_name(name)?;
+                    Compare::Snapshot(name.to_string(), view)
+                }
                 "swap" | "off" if more.is_empty() => {
                     if what == "swap" {
                         Compare::Swap
@@ -336,6 +350,23 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
         "probe" => {
             arity(2)?;
             Ok(Step::Do(Action::Probe { x: number(args[0], "x")?, y: number(args[1], "y")? }))
+        }
+        "snapshot" => {
+            if args.len() > 1 {
+                return Err("'snapshot' takes at most a name".into());
+            }
+            let name = args.first().map(|name| crate::viewer::snapshots::check_name(name).map(|()| name.to_string()));
+            Ok(Step::Do(Action::Snapshot(name.transpose()?)))
+        }
+        "restore" | "delete-snapshot" => {
+            arity(1)?;
+            crate::viewer::snapshots::check_name(args[0])?;
+            let name = args[0].to_string();
+            Ok(Step::Do(if command == "restore" {
+                Action::RestoreSnapshot(name)
+            } else {
+                Action::DeleteSnapshot(name)
+            }))
         }
         other => Err(format!("unknown command '{other}' (expected one of: {COMMANDS})")),
     }
@@ -504,6 +535,34 @@ mod tests {
             ("clipping maybe", "'maybe' is not on or off"),
             ("probe 1", "'probe' takes 2 arguments"),
             ("probe -1 2", "x '-1' is not a whole number"),
+        ] {
+            let message = parse(line).unwrap_err().to_string();
+            assert!(message.contains(problem), "{line}: {message}");
+        }
+    }
+
+    #[test]
+    fn snapshot_commands_parse_and_bad_names_are_refused_at_their_line() {
+        let script = parse(
+            "snapshot\nsnapshot before\nrestore before\ncompare snapshot before delta-e\ncompare snapshot a side\n\
+                   compare snapshot b\ndelete-snapshot b\n",
+        )
+        .unwrap();
+        let steps: Vec<&Step> = script.steps.iter().map(|(_, s)| s).collect();
+        assert_eq!(*steps[0], Step::Do(Action::Snapshot(None)));
+        assert_eq!(*steps[1], Step::Do(Action::Snapshot(Some("before".into()))));
+        assert_eq!(*steps[2], Step::Do(Action::RestoreSnapshot("before".into())));
+        assert_eq!(*steps[3], Step::Do(Action::Compare(Compare::Snapshot("before".into(), SnapshotView::DeltaE))));
+        assert_eq!(*steps[4], Step::Do(Action::Compare(Compare::Snapshot("a".into(), SnapshotView::Side))));
+        assert_eq!(*steps[5], Step::Do(Action::Compare(Compare::Snapshot("b".into(), SnapshotView::Split))));
+        assert_eq!(*steps[6], Step::Do(Action::DeleteSnapshot("b".into())));
+        for (line, problem) in [
+            ("snapshot ../up", "edit.script:1: snapshot name '../up' has '/'"),
+            ("snapshot a b", "'snapshot' takes at most a name"),
+            ("restore", "'restore' takes 1 argument"),
+            ("restore -x", "must start with a letter or a digit"),
+            ("compare snapshot", "'compare snapshot' takes a name"),
+            ("compare snapshot a wipe", "unknown snapshot view 'wipe' (expected split, side or delta-e)"),
         ] {
             let message = parse(line).unwrap_err().to_string();
             assert!(message.contains(problem), "{line}: {message}");

@@ -3,8 +3,10 @@
 //! materials changed, an environment, lighting, seed), so that an edit costs one restart and
 //! an exposure change costs no samples at all.
 
-use super::compare::{self, Compare, Subject};
+use super::compare::{self, Compare, SnapshotView, Subject};
+use super::delta_e::DeltaE;
 use super::progressive::{Progressive, FRAME_BUDGET};
+use super::snapshots::{Capture, Snapshots};
 use crate::environment::{self, Environment, LoadOptions};
 use crate::gbuffer::GBuffer;
 use crate::gpu::{Context, Image};
@@ -124,6 +126,21 @@ pub struct Session {
     /// Where the split is, as a fraction of the image's width from the left; kept while the
     /// split is off, so turning it back on finds it where it was.
     pub divider: f32,
+    /// The look file's snapshots.
+    pub snapshots: Snapshots,
+    /// The snapshot shown as B, instead of a live renderer.
+    snapshot_compare: Option<SnapshotCompare>,
+}
+
+/// A snapshot as B: which, how, and its ΔE map against the live image when shown as one.
+pub struct SnapshotCompare {
+    pub name: String,
+    /// The snapshot's [`Snapshot::id`](super::snapshots::Snapshot::id).
+    pub id: u64,
+    pub view: SnapshotView,
+    pub delta: Option<DeltaE>,
+    /// The live image's samples and document revision the map was made at.
+    delta_key: Option<(u32, u64)>,
 }
 
 impl Session {
@@ -172,6 +189,8 @@ impl Session {
             compare: None,
             retired: Vec::new(),
             divider: 0.5,
+            snapshots: Snapshots::default(),
+            snapshot_compare: None,
         })
     }
 
@@ -245,7 +264,7 @@ impl Session {
     /// Whether B's image is ready to be shown: B has finished its first pass. Until then, B's
     /// half of the split shows A.
     pub fn compare_ready(&self) -> bool {
-        self.compare.as_ref().is_some_and(|b| b.renderer.has_finished_a_pass())
+        self.snapshot_compare.is_some() || self.compare.as_ref().is_some_and(|b| b.renderer.has_finished_a_pass())
     }
 
     /// What B is, when comparing.
@@ -260,6 +279,10 @@ impl Session {
 
     /// The labels of the two halves, "A: …" and "B: …", when comparing.
     pub fn compare_labels(&self) -> Option<(String, String)> {
+        if let Some(shown) = &self.snapshot_compare {
+            let spp = self.snapshots.get(&shown.name).map_or(0, |s| s.spp);
+            return Some(("A: live".into(), format!("B: snapshot {} · {spp} spp", shown.name)));
+        }
         let b = self.compare.as_ref()?;
         let a_model = self.document.settings().model;
         Some(match &b.subject {
@@ -279,7 +302,8 @@ impl Session {
 
     /// The image column where B starts, when comparing.
     pub fn split_column(&self) -> Option<u32> {
-        self.compare.as_ref().map(|_| compare::split_column(self.divider, self.width()))
+        let snapshot_split = self.snapshot_compare.as_ref().is_some_and(|s| s.view == SnapshotView::Split);
+        (self.compare.is_some() || snapshot_split).then(|| compare::split_column(self.divider, self.width()))
     }
 
     /// Shows B: A's stacks under `model`. Replaces whatever B was.
@@ -312,12 +336,14 @@ impl Session {
         let mut progressive = Progressive::new();
         progressive.set_budget(FRAME_BUDGET / 2);
         self.progressive.set_budget(FRAME_BUDGET / 2);
+        self.snapshot_compare = None;
         self.retired.extend(self.compare.replace(Compare { subject, renderer, progressive, packed }));
         Ok(())
     }
 
     /// Back to the plain image: B's renderer goes and A has the whole frame budget.
     pub fn compare_off(&mut self) {
+        self.snapshot_compare = None;
         self.retired.extend(self.compare.take());
         self.progressive.set_budget(FRAME_BUDGET);
     }
@@ -638,6 +664,124 @@ impl Session {
         let settings = self.document.settings();
         self.renderer.finalize_rows(0, self.height(), settings.exposure, settings.tonemap)?;
         Ok(radiance)
+    }
+}
+
+impl Session {
+    /// The image as `save-image` saves it (the pass completed, so a whole number of passes):
+    /// linear radiance with the render's metadata, and the display pixels.
+    fn capture(&mut self) -> Result<Capture> {
+        self.complete_pass()?;
+        if self.samples() == 0 {
+            return Err(Error::input("snapshot: nothing has been rendered yet"));
+        }
+        let settings = self.document.settings().clone();
+        let radiance = self.renderer.read_radiance()?;
+        output::check_finite(Path::new("snapshot"), &radiance)?;
+        // Reading radiance remade the display pixels in linear; this remakes them as shown.
+        let display = self.renderer.read_display(settings.exposure, settings.tonemap)?;
+        let environment = self.environments.iter().find(|(p, _)| *p == self.shown.environment).map(|(_, e)| e);
+        let metadata =
+            environment.map(|e| output::Metadata::of_render(self.document.look(), &settings, e)).unwrap_or_default();
+        Ok(Capture {
+            radiance,
+            display,
+            spp: self.renderer.samples(),
+            metadata: metadata.entries,
+            background: settings.lighting.background,
+        })
+    }
+
+    /// Snapshots the live image with the look and settings that made it. Returns its name.
+    pub fn take_snapshot(&mut self, name: Option<&str>) -> Result<String> {
+        let name = self.snapshots.name_for_new(name)?;
+        let capture = self.capture()?;
+        let (look, settings) = (self.document.look().clone(), self.document.settings().clone());
+        let size = (self.width(), self.height());
+        Ok(self.snapshots.add(name, &look, &settings, capture, size)?.name.clone())
+    }
+
+    /// Shows a snapshot as B. Its image must be the live image's size.
+    pub fn compare_snapshot(&mut self, name: &str, view: SnapshotView) -> Result<()> {
+        let snapshot = self.snapshots.get(name)?;
+        if (snapshot.width, snapshot.height) != (self.width(), self.height()) {
+            return Err(Error::input(format!(
+                "snapshot '{name}' is {}x{}, but the g-buffer {} is {}x{}: it was taken of another g-buffer",
+                snapshot.width,
+                snapshot.height,
+                self.gbuffer_name.display(),
+                self.width(),
+                self.height()
+            )));
+        }
+        let id = snapshot.id;
+        self.compare_off();
+        self.snapshot_compare =
+            Some(SnapshotCompare { name: name.to_string(), id, view, delta: None, delta_key: None });
+        self.refresh_delta_e()
+    }
+
+    /// The snapshot shown as B, if one is.
+    pub fn snapshot_compare(&self) -> Option<&SnapshotCompare> {
+        self.snapshot_compare.as_ref()
+    }
+
+    /// Remakes the ΔE map when the live image has changed: at 1, 2, 4, … samples and at the
+    /// target, as the inspector follows accumulation, and after every change of the look.
+    pub fn refresh_delta_e(&mut self) -> Result<()> {
+        let (samples, revision, target) = (self.samples(), self.document.revision(), self.target());
+        let Some(shown) = self.snapshot_compare.as_mut().filter(|s| s.view == SnapshotView::DeltaE) else {
+            return Ok(());
+        };
+        let key = Some((samples, revision));
+        let due = shown.delta_key.is_none_or(|(_, r)| r != revision) || samples.is_power_of_two() || samples >= target;
+        if samples == 0 || shown.delta_key == key || !due {
+            return Ok(());
+        }
+        let Some(snapshot) = self.snapshots.list.iter().find(|s| s.id == shown.id) else { return Ok(()) };
+        let settings = self.document.settings();
+        let live = self.renderer.read_display(settings.exposure, settings.tonemap)?;
+        shown.delta = Some(DeltaE::between(self.gbuffer.width, self.gbuffer.height, &live, &snapshot.display));
+        shown.delta_key = key;
+        Ok(())
+    }
+
+    /// The ΔE map's live sample count, when one is shown.
+    pub fn delta_e_samples(&self) -> Option<u32> {
+        self.snapshot_compare.as_ref().and_then(|s| s.delta.as_ref().and(s.delta_key)).map(|(samples, _)| samples)
+    }
+
+    /// Lists the snapshots of the document's look file when that file changed (a look was
+    /// opened, or saved under another name). When it did, returns warnings for snapshots that
+    /// cannot be read.
+    pub fn follow_look_file(&mut self) -> Option<Vec<String>> {
+        if self.snapshots.look_file() == self.document.path() {
+            return None;
+        }
+        let (snapshots, warnings) = Snapshots::open(self.document.path());
+        self.snapshots = snapshots;
+        self.snapshot_compare = None;
+        Some(warnings)
+    }
+
+    /// The edit that restores a snapshot's look and settings, once they are known to fit the
+    /// g-buffer and its environment is loaded.
+    pub fn restore_edit(&mut self, name: &str) -> Result<crate::viewer_state::Edit> {
+        let snapshot = self.snapshots.get(name)?;
+        let (look, settings) = (snapshot.look.clone(), snapshot.settings.clone());
+        PackedStacks::pack(&look, self.objects.iter().copied(), &self.gbuffer, &self.gbuffer_name)
+            .map_err(|e| Error::input(format!("snapshot '{name}' cannot be restored: {e}")))?;
+        self.load_environment(settings.environment.as_deref())?;
+        Ok(crate::viewer_state::Edit::Restore { look: Box::new(look), settings: Box::new(settings) })
+    }
+
+    /// Deletes a snapshot; comparing against it ends.
+    pub fn delete_snapshot(&mut self, name: &str) -> Result<()> {
+        self.snapshots.delete(name)?;
+        if self.snapshot_compare.as_ref().is_some_and(|s| s.name == name) {
+            self.snapshot_compare = None;
+        }
+        Ok(())
     }
 }
 

@@ -141,6 +141,13 @@ pub enum Edit {
     SetSeed(u32),
     /// The BRDF model (the look's `[model]` table).
     SetModel(Model),
+    /// Replaces the look and the render settings at once, as restoring a snapshot does: one
+    /// undo step, so that undo brings back exactly the state before. The look keeps the
+    /// document's file, and its `[environment]` and `[render]` tables follow the settings.
+    Restore {
+        look: Box<Look>,
+        settings: Box<Settings>,
+    },
 }
 
 /// What makes two edits parts of one gesture, such as a slider drag: the same kind of edit on the
@@ -311,6 +318,12 @@ impl State {
             }
             Edit::SetSeed(seed) => next.settings.seed = seed,
             Edit::SetModel(model) => next.settings.model = model,
+            Edit::Restore { look, settings } => {
+                let file = next.look.file.take();
+                next.look = *look;
+                next.look.file = file;
+                next.settings = *settings;
+            }
         }
         next.mirror_settings(saved);
         Ok(next)

@@ -10,7 +10,7 @@ use crate::shading::model::{Diffuse, Fresnel, Model, SpecularD, SpecularG, GTR_G
 pub fn show(ui: &mut egui::Ui, session: &Session, file_dialog: &mut Option<FileDialog>, actions: &mut Vec<Action>) {
     ui.heading("Compare");
     let subject = session.compare_subject();
-    let mut on = subject.is_some();
+    let mut on = subject.is_some() || session.snapshot_compare().is_some();
     let toggle = ui
         .checkbox(&mut on, "A/B split")
         .on_hover_text("A (the edited look) left of the divider, B right of it; drag the divider in the image");
@@ -21,6 +21,9 @@ pub fn show(ui: &mut egui::Ui, session: &Session, file_dialog: &mut Option<FileD
         } else {
             Compare::Off
         }));
+    }
+    if let Some(shown) = session.snapshot_compare() {
+        ui.label(format!("B: snapshot {} ({}; see Snapshots)", shown.name, shown.view.label()));
     }
     let Some(subject) = subject else { return };
     let a = a_model(session);

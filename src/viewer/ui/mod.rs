@@ -12,6 +12,7 @@ pub mod hotkeys;
 mod inspector;
 mod layers;
 mod lighting;
+mod snapshots;
 mod viewport;
 mod views;
 
@@ -73,6 +74,7 @@ pub struct Interface {
     pub placement: Option<ImagePlacement>,
     /// The hotkey sheet is open.
     pub hotkeys: bool,
+    snapshots: snapshots::Panel,
 }
 
 impl Interface {
@@ -96,6 +98,7 @@ impl Interface {
     /// Lays out and runs one frame of the interface.
     pub fn show(&mut self, ui: &mut egui::Ui, frame: &Frame, thumbnails: &mut Thumbnails, actions: &mut Vec<Action>) {
         self.shortcuts(ui.ctx(), frame, actions);
+        self.snapshots.prepare(ui.ctx(), frame.session);
         egui::Panel::top("menu").show(ui, |ui| self.menu(ui, frame, actions));
         egui::Panel::bottom("status").show(ui, |ui| self.status(ui, frame));
         // Each side panel scrolls what does not fit, both ways, rather than growing with its
@@ -118,12 +121,18 @@ impl Interface {
                 inspector::show(ui, frame.session);
                 ui.separator();
                 views::histogram(ui, frame.views);
+                ui.separator();
+                self.snapshots.show(ui, frame.session, actions);
             })
         });
+        let snapshot = self.snapshots.shown(frame.session);
+        // A snapshot split shows the snapshot's image as B.
+        let compare = snapshot.as_ref().map_or(frame.compare_texture, |s| Some(s.texture));
         egui::CentralPanel::no_frame().show(ui, |ui| {
             // A view other than the beauty shows in A's place (B, in a split, keeps its beauty).
             let a = frame.views.texture().unwrap_or(frame.view_texture);
-            self.placement = Some(self.viewport.show(ui, frame.session, a, frame.compare_texture, actions));
+            let placement = self.viewport.show(ui, frame.session, a, compare, snapshot.as_ref(), actions);
+            self.placement = Some(placement);
             views::decorate(ui, frame.session, frame.views, self.viewport.image_rect);
         });
         let ctx = ui.ctx().clone();
@@ -181,6 +190,9 @@ impl Interface {
                 self.hotkeys = !self.hotkeys;
             }
             views::shortcuts(input, actions);
+            if input.consume_key(Modifiers::NONE, Key::P) {
+                actions.push(Action::Snapshot(None));
+            }
         });
     }
 
@@ -228,6 +240,12 @@ impl Interface {
                 ui.separator();
                 if ui.button("Add layer from library…").clicked() {
                     self.browser.open = true;
+                }
+                ui.separator();
+                let has_file = document.path().is_some();
+                let snapshot = egui::Button::new("Take snapshot").shortcut_text("P");
+                if ui.add_enabled(has_file, snapshot).on_disabled_hover_text("Save the look first").clicked() {
+                    actions.push(Action::Snapshot(None));
                 }
             });
             ui.menu_button("View", |ui| {

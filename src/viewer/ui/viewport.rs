@@ -2,6 +2,7 @@
 //! inspects a pixel and selects its object.
 
 use super::super::action::Action;
+use super::super::compare::SnapshotView;
 use super::super::session::Session;
 use crate::viewer_state::Edit;
 use egui::{pos2, vec2, Color32, PointerButton, Rect, Sense};
@@ -40,6 +41,8 @@ pub struct ImagePlacement {
     pub height: u32,
     /// Window pixels per image pixel.
     pub scale: f32,
+    /// Where the snapshot's image was drawn beside it, side by side.
+    pub second: Option<(i32, i32)>,
 }
 
 impl Viewport {
@@ -64,18 +67,22 @@ impl Viewport {
         session: &Session,
         texture: egui::TextureId,
         compare: Option<egui::TextureId>,
+        snapshot: Option<&super::snapshots::Shown>,
         actions: &mut Vec<Action>,
     ) -> ImagePlacement {
         let rect = ui.max_rect();
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
+        let side = snapshot.filter(|s| s.view == SnapshotView::Side);
+        // Side by side, each image has half the view; the live one is on the left.
+        let view = if side.is_some() { Rect::from_min_max(rect.min, pos2(rect.center().x, rect.max.y)) } else { rect };
         let ppp = ui.ctx().pixels_per_point();
         let (w, h) = (session.width() as f32, session.height() as f32);
         // Fit fills the view both ways: a small g-buffer is magnified rather than left a postage
         // stamp (nearest filtering keeps its pixels sharp).
-        let fit = (rect.width() * ppp / w).min(rect.height() * ppp / h).clamp(MIN_SCALE, MAX_SCALE);
+        let fit = (view.width() * ppp / w).min(view.height() * ppp / h).clamp(MIN_SCALE, MAX_SCALE);
         let scale = self.scale.unwrap_or(fit);
         let size = vec2(w, h) * scale / ppp;
-        let centre = rect.center() + self.pan;
+        let centre = view.center() + self.pan;
         // On whole window pixels, so that 1:1 shows each image pixel exactly once.
         let min = ((centre - size / 2.0).to_vec2() * ppp).round() / ppp;
         let image_rect = Rect::from_min_size(min.to_pos2(), size);
@@ -83,9 +90,23 @@ impl Viewport {
         let painter = ui.painter_at(rect);
         painter.rect_filled(rect, 0.0, Color32::from_gray(18));
         let split = compare.zip(session.split_column());
+        let whole = Rect::from_min_max(pos2(0.0, 0.0), pos2(1.0, 1.0));
+        let mut second = None;
         match split {
+            None if side.is_some() => {
+                let b_rect = image_rect.translate(vec2(rect.center().x - rect.min.x, 0.0));
+                ui.painter_at(view).image(texture, image_rect, whole, Color32::WHITE);
+                let right = Rect::from_min_max(pos2(rect.center().x, rect.min.y), rect.max);
+                ui.painter_at(right).image(side.expect("side").texture, b_rect, whole, Color32::WHITE);
+                second = Some(((b_rect.min.x * ppp).round() as i32, (b_rect.min.y * ppp).round() as i32));
+                if let Some((a, b)) = session.compare_labels() {
+                    side_labels(&painter, image_rect, b_rect, (a, b));
+                }
+            }
             None => {
-                painter.image(texture, image_rect, Rect::from_min_max(pos2(0.0, 0.0), pos2(1.0, 1.0)), Color32::WHITE);
+                // The ΔE view shows the heat map in the image's place, once it is made.
+                let shown = snapshot.filter(|s| s.view == SnapshotView::DeltaE).and_then(|s| s.heat).unwrap_or(texture);
+                painter.image(shown, image_rect, whole, Color32::WHITE);
             }
             Some((b, column)) => {
                 // Both images cover the whole frame; each half shows its own part, so dragging
@@ -123,12 +144,16 @@ impl Viewport {
         if let (Some((_, column)), Some(labels)) = (split, session.compare_labels()) {
             split_overlay(&painter, image_rect, image_rect.min.x + image_rect.width() * column as f32 / w, labels);
         }
+        if let Some(shown) = snapshot.filter(|s| s.view == SnapshotView::DeltaE) {
+            delta_e_legend(&painter, rect, shown);
+        }
         ImagePlacement {
             x: (image_rect.min.x * ppp).round() as i32,
             y: (image_rect.min.y * ppp).round() as i32,
             width: (size.x * ppp).round() as u32,
             height: (size.y * ppp).round() as u32,
             scale,
+            second,
         }
     }
 
@@ -283,6 +308,49 @@ fn crosshair(painter: &egui::Painter, view: Rect, image: Rect, (x, y): (u32, u32
     if view.y_range().contains(centre.y) {
         painter.line_segment([pos2(view.min.x, centre.y), pos2(left, centre.y)], stroke);
         painter.line_segment([pos2(right, centre.y), pos2(view.max.x, centre.y)], stroke);
+    }
+}
+
+/// Side by side: each image's label above its top-left corner, on a dark plate.
+fn side_labels(painter: &egui::Painter, a_rect: Rect, b_rect: Rect, (a, b): (String, String)) {
+    let font = egui::FontId::proportional(12.0);
+    for (text, rect) in [(a, a_rect), (b, b_rect)] {
+        let galley = painter.layout_no_wrap(text, font.clone(), Color32::WHITE);
+        let plate =
+            egui::Align2::LEFT_BOTTOM.anchor_size(rect.left_top() - vec2(0.0, 2.0), galley.size() + vec2(8.0, 6.0));
+        painter.rect_filled(plate, 2.0, Color32::from_black_alpha(170));
+        painter.galley(plate.min + vec2(4.0, 3.0), galley, Color32::WHITE);
+    }
+}
+
+/// The ΔE view's legend, top left of the view: the heat map's colour ramp with its stops, and
+/// the mean and largest difference.
+fn delta_e_legend(painter: &egui::Painter, view: Rect, shown: &super::snapshots::Shown) {
+    use super::super::delta_e::{heat, STOPS};
+    let font = egui::FontId::proportional(12.0);
+    let top_left = view.left_top() + vec2(10.0, 10.0);
+    let (width, height) = (200.0, 12.0);
+    let top = STOPS[STOPS.len() - 1].0;
+    let plate = Rect::from_min_size(top_left - vec2(6.0, 6.0), vec2(width + 28.0, 54.0));
+    painter.rect_filled(plate, 3.0, Color32::from_black_alpha(190));
+    let title = match shown.delta {
+        Some((mean, max)) => format!("ΔE2000 vs {}: mean {mean:.2}, max {max:.2}", shown.name),
+        None => format!("ΔE2000 vs {}: waiting for the image", shown.name),
+    };
+    painter.text(top_left, egui::Align2::LEFT_TOP, title, font.clone(), Color32::WHITE);
+    let bar = Rect::from_min_size(top_left + vec2(0.0, 20.0), vec2(width, height));
+    let steps = 100;
+    for i in 0..steps {
+        let [r, g, b] = heat(top * (i as f32 + 0.5) / steps as f32);
+        let x0 = bar.min.x + width * i as f32 / steps as f32;
+        let slice = Rect::from_min_max(pos2(x0, bar.min.y), pos2(x0 + width / steps as f32 + 0.5, bar.max.y));
+        painter.rect_filled(slice, 0.0, Color32::from_rgb(r, g, b));
+    }
+    for (value, _) in STOPS {
+        let x = bar.min.x + width * value / top;
+        painter.line_segment([pos2(x, bar.max.y), pos2(x, bar.max.y + 3.0)], egui::Stroke::new(1.0, Color32::WHITE));
+        let label = if value == top { format!("{value}+") } else { format!("{value}") };
+        painter.text(pos2(x, bar.max.y + 4.0), egui::Align2::CENTER_TOP, label, font.clone(), Color32::from_gray(210));
     }
 }
 
