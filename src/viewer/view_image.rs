@@ -22,8 +22,17 @@ pub struct ViewImage {
     pub width: u32,
     /// Linear values per pixel (a scalar in channel 0).
     pub linear: Vec<[f32; 3]>,
-    /// Display-referred sRGB bytes per pixel, as the view shows them.
+    /// Display-referred sRGB bytes per pixel, as the view shows them. Empty for the beauty
+    /// while the clipping overlay is off: the renderer's display image shows it, and the value
+    /// under the cursor is encoded alone.
     pub display: Vec<[u8; 3]>,
+    /// What the display encodes, where it is not `linear` (the beauty's surface colour, with
+    /// the background off).
+    shown: Option<Vec<[f32; 3]>>,
+    /// How, with the settings of the read.
+    encoding: views::Encoding,
+    exposure: f32,
+    tonemap: crate::shading::tonemap::Tonemap,
     pub histogram: Option<Histogram>,
     /// The samples and the document's edition it was read at.
     pub samples: u32,
@@ -35,7 +44,14 @@ impl ViewImage {
     /// bar shows under the cursor.
     pub fn describe(&self, x: u32, y: u32) -> Option<String> {
         let p = (y as usize).checked_mul(self.width as usize)? + x as usize;
-        let (v, d) = (self.linear.get(p)?, self.display.get(p)?);
+        let v = self.linear.get(p)?;
+        let d = match self.display.get(p) {
+            Some(d) => *d,
+            None => {
+                let shown = self.shown.as_ref().unwrap_or(&self.linear).get(p)?;
+                views::encode(self.encoding, *shown, self.exposure, self.tonemap)
+            }
+        };
         let linear = match self.channels {
             1 => format!("{:.6}", v[0]),
             _ => format!("{:.6},{:.6},{:.6}", v[0], v[1], v[2]),
@@ -137,7 +153,8 @@ impl Views {
     fn due(&self, session: &Session) -> bool {
         let samples = session.a_samples();
         let Some(image) = &self.image else { return self.readable(session) };
-        if image.view != self.current || image.edition != edition(session) {
+        let overlay_unmade = self.clipping && image.display.is_empty();
+        if image.view != self.current || image.edition != edition(session) || overlay_unmade {
             return self.readable(session);
         }
         if !self.current.follows_samples() || samples == image.samples || samples == 0 {
@@ -180,8 +197,12 @@ impl Views {
         };
         let encoding = view.encoding(channels);
         let (exposure, tonemap) = (settings.exposure, settings.tonemap);
-        let display =
-            shown.as_ref().unwrap_or(&linear).iter().map(|v| views::encode(encoding, *v, exposure, tonemap)).collect();
+        // The beauty needs display pixels only for the overlay: encoding a large image costs.
+        let display = if view != View::Beauty || self.clipping {
+            shown.as_ref().unwrap_or(&linear).iter().map(|v| views::encode(encoding, *v, exposure, tonemap)).collect()
+        } else {
+            Vec::new()
+        };
         // Radiance with the background shown counts every pixel; everything else the covered ones.
         let everything = view.is_radiance() && settings.lighting.background;
         let coverage = &session.gbuffer.coverage;
@@ -192,6 +213,10 @@ impl Views {
             width: session.width(),
             linear,
             display,
+            shown,
+            encoding,
+            exposure,
+            tonemap,
             histogram,
             samples: session.a_samples(),
             edition: edition(session),
