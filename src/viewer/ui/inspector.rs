@@ -4,6 +4,18 @@ use super::super::session::Session;
 use crate::material::params::{Param, Value};
 use egui::RichText;
 
+/// The most characters a name takes in the inspector's grid, and as the light's environment: a
+/// longer one is cut with "…" (the whole name on hover), so that what follows stays in view.
+const NAME_CHARS: usize = 28;
+
+/// `text`, cut to [`NAME_CHARS`] characters with "…" if longer.
+pub(super) fn elide(text: &str) -> String {
+    match text.char_indices().nth(NAME_CHARS - 1) {
+        Some((end, _)) if text.chars().count() > NAME_CHARS => format!("{}…", &text[..end]),
+        _ => text.to_string(),
+    }
+}
+
 pub fn show(ui: &mut egui::Ui, session: &Session) {
     ui.heading("Inspector");
     let Some(pixel) = &session.inspection else {
@@ -16,21 +28,25 @@ pub fn show(ui: &mut egui::Ui, session: &Session) {
         ui.end_row();
         ui.label("Object");
         let name = pixel.object_name.as_ref().map(|n| format!(" ({n})")).unwrap_or_default();
-        ui.label(format!("{}{name}", pixel.object_id));
+        let object = format!("{}{name}", pixel.object_id);
+        ui.label(elide(&object)).on_hover_text(object);
         ui.end_row();
         ui.label("Coverage");
         ui.label(format!("{:.3}", pixel.coverage));
         ui.end_row();
         for (name, value) in &pixel.masks {
-            let label = ui.label(format!("mask.{name}"));
-            if let Some((_, full)) = pixel.mask_names.iter().find(|(mask, _)| mask == name) {
-                label.on_hover_text(full.as_str());
-            }
+            let channel = format!("mask.{name}");
+            let label = ui.label(elide(&channel));
+            match pixel.mask_names.iter().find(|(mask, _)| mask == name) {
+                Some((_, full)) => label.on_hover_text(full.as_str()),
+                None => label.on_hover_text(channel),
+            };
             ui.label(format!("{value:.3}"));
             ui.end_row();
         }
         for (name, value) in &pixel.maps {
-            ui.label(format!("map.{name}"));
+            let channel = format!("map.{name}");
+            ui.label(elide(&channel)).on_hover_text(channel);
             ui.label(format!("{value:.3}"));
             ui.end_row();
         }
@@ -81,4 +97,19 @@ pub fn show(ui: &mut egui::Ui, session: &Session) {
             ui.end_row();
         }
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn long_names_are_cut_to_a_fixed_width() {
+        assert_eq!(elide("mask.stripes"), "mask.stripes");
+        let long = "mask.the_long_production_asset_name_v042";
+        let cut = elide(long);
+        assert_eq!(cut.chars().count(), NAME_CHARS);
+        assert!(cut.ends_with('…') && long.starts_with(cut.trim_end_matches('…')), "{cut}");
+        assert_eq!(elide(&"é".repeat(NAME_CHARS)), "é".repeat(NAME_CHARS), "a name of exactly the width stays");
+    }
 }

@@ -16,7 +16,7 @@ pub fn show(ui: &mut egui::Ui, session: &Session, file_dialog: &mut Option<FileD
         .as_ref()
         .map_or("studio (built-in)".to_string(), |p| p.file_name().unwrap_or(p.as_os_str()).to_string_lossy().into());
     ui.horizontal(|ui| {
-        ui.label(name).on_hover_text(
+        ui.label(super::inspector::elide(&name)).on_hover_text(
             settings
                 .environment
                 .as_ref()
