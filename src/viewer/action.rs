@@ -65,6 +65,8 @@ pub enum Action {
     Key(egui::Key, egui::Modifiers),
     /// Sets the zoom: `None` fits the image to the view, else window pixels per image pixel.
     Zoom(Option<f32>),
+    /// Shows the display filter (denoise) or not: what is shown only, never what is saved.
+    Denoise(bool),
 }
 
 /// What to show as B, beside the edited look (A).

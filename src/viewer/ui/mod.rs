@@ -22,6 +22,10 @@ use super::thumbnails::Thumbnails;
 use egui::{Key, KeyboardShortcut, Modifiers};
 use std::time::{Duration, Instant};
 
+/// What the display filter is, where it is offered and marked.
+const DENOISE_HINT: &str = "Shows the accumulation through an edge-avoiding filter guided by the g-buffer's normals, \
+    base colours and object ids. Only the view: saved images are never filtered.";
+
 /// How long a status message stays.
 const MESSAGE_TIME: Duration = Duration::from_secs(8);
 
@@ -165,6 +169,9 @@ impl Interface {
             if input.consume_key(Modifiers::NONE, Key::Num1) {
                 self.viewport.actual_pixels();
             }
+            if input.consume_key(Modifiers::NONE, Key::D) {
+                actions.push(Action::Denoise(!frame.session.denoise));
+            }
         });
     }
 
@@ -221,6 +228,12 @@ impl Interface {
                 if ui.add(egui::Button::new("Actual pixels (1:1)").shortcut_text("1")).clicked() {
                     self.viewport.actual_pixels();
                 }
+                ui.separator();
+                let denoise =
+                    egui::Button::selectable(frame.session.denoise, "Denoise (display filter)").shortcut_text("D");
+                if ui.add(denoise).on_hover_text(DENOISE_HINT).clicked() {
+                    actions.push(Action::Denoise(!frame.session.denoise));
+                }
             });
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
                 let name = document.path().map_or("untitled look".to_string(), |p| p.display().to_string());
@@ -248,6 +261,17 @@ impl Interface {
                 ui.separator();
                 ui.label(format!("first pass {:.0} ms", first.as_secs_f64() * 1e3))
                     .on_hover_text("Time from the last change to a first full pass over the image");
+            }
+            if let Some((preview, block)) = session.progressive.preview {
+                ui.separator();
+                ui.label(format!("preview {:.0} ms", preview.as_secs_f64() * 1e3)).on_hover_text(format!(
+                    "Time from the last change to a whole frame at the new state, one sample per {block}×{block} block"
+                ));
+            }
+            if session.denoise {
+                ui.separator();
+                ui.label(egui::RichText::new("denoised · display filter").color(ui.visuals().warn_fg_color))
+                    .on_hover_text(DENOISE_HINT);
             }
             ui.separator();
             ui.label(format!("{}×{} · {}", session.width(), session.height(), session.device_name()));
