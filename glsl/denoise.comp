@@ -3,8 +3,10 @@
 // (Dammertz et al. 2010) of the linear radiance, guided by the g-buffer. Each iteration is a
 // 5×5 B3-spline kernel with holes `step` pixels apart (1, 2, 4, …), each tap weighted down by
 // how far its normal, its base colour and its radiance are from the centre's, and dropped
-// outright on another object or off the surface: noise is averaged within a surface and edges
-// stay sharp. Background pixels (no coverage) are exact already and pass through. The last
+// outright on another object or where the surface does not cover the whole pixel: noise is
+// averaged within a surface and edges stay sharp. Pixels the surface covers only in part (the
+// silhouettes, whose radiance holds some background) and background pixels, which are exact
+// already, pass through. The last
 // iteration also makes display pixels, as finalize.comp does. Only ever shown, never saved.
 #extension GL_GOOGLE_include_directive : require
 
@@ -50,7 +52,7 @@ void main() {
     vec4 centre = imageLoad(source, pixel);
     vec4 normal_coverage = imageLoad(surface, ivec3(pixel, 0));
     vec4 result = centre;
-    if (normal_coverage.w > 0.0) {
+    if (normal_coverage.w >= 1.0) {
         uint id = imageLoad(object_ids, pixel).r;
         vec3 albedo = imageLoad(resolved, ivec3(pixel, 0)).rgb;
         vec3 colour = compress(centre.rgb);
@@ -63,7 +65,7 @@ void main() {
                     continue;
                 }
                 vec4 q_normal_coverage = imageLoad(surface, ivec3(q, 0));
-                if (q_normal_coverage.w <= 0.0 || imageLoad(object_ids, q).r != id) {
+                if (q_normal_coverage.w < 1.0 || imageLoad(object_ids, q).r != id) {
                     continue;
                 }
                 vec4 q_value = imageLoad(source, q);

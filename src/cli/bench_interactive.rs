@@ -11,8 +11,8 @@ use crate::Result;
 use std::time::{Duration, Instant};
 
 const SIZES: [(u32, u32); 2] = [(1024, 1024), (1920, 1080)];
-/// The preview blocks the viewer chooses between on most devices.
-const BLOCKS: [u32; 2] = [2, 4];
+/// The preview blocks the viewer chooses between.
+const BLOCKS: [u32; 3] = [2, 4, 8];
 /// Degrees the light turns per edit: enough that no pixel keeps its value.
 const TURN: f32 = 37.0;
 
