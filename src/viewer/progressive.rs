@@ -94,9 +94,8 @@ impl Progressive {
     }
 
     /// The preview's block: the smallest whose one sample per block is expected to fit the
-    /// budget at the measured speed (a relit row of blocks costs about a row's sample; each
-    /// pixel's background about a tenth of one), or 4 before anything is measured: a block
-    /// of b × b relights a b²-th of the rows' pixels.
+    /// budget at the measured speed, or 4 before anything is measured. Blocks of b × b relight
+    /// a b²-th of the pixels; every pixel's background costs about a tenth of a sample.
     fn preview_block(&self, height: u32) -> u32 {
         if self.row_seconds <= 0.0 {
             return 4;
@@ -109,8 +108,9 @@ impl Progressive {
     }
 
     /// Relights the next band if the image has fewer than `target` samples, then makes its
-    /// display pixels. The first pass after a change takes one sample per band, so the whole
-    /// image changes soonest; later bands take a few. Returns whether anything was rendered.
+    /// display pixels. The first frame after a change is the preview instead; the first pass
+    /// takes one sample per band, so the preview is replaced soonest; later bands take a few.
+    /// Returns whether anything was rendered.
     pub fn step(&mut self, renderer: &mut Renderer, target: u32, exposure: f32, tonemap: Tonemap) -> Result<bool> {
         if renderer.samples() >= target {
             return Ok(false);
@@ -166,6 +166,23 @@ impl Progressive {
             0.0
         } else {
             samples / busy.as_secs_f64()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_preview_block_is_the_smallest_that_fits_the_budget() {
+        let mut progressive = Progressive::new();
+        progressive.set_budget(Duration::from_millis(25));
+        assert_eq!(progressive.preview_block(1000), 4, "before any measurement");
+        // 1000 rows: 2×2 costs 250 + 100 row-samples, 4×4 62.5 + 100.
+        for (row_seconds, block) in [(50e-6, 2), (100e-6, 4), (1e-3, 8)] {
+            progressive.row_seconds = row_seconds;
+            assert_eq!(progressive.preview_block(1000), block, "{row_seconds} s a row");
         }
     }
 }
