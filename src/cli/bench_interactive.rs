@@ -2,7 +2,8 @@
 //! light (which changes every pixel), and the time is taken from the change to a complete frame
 //! at the new state: by a first full-resolution pass, as the viewer showed it before it had a
 //! preview (a lower bound: it swept the pass in bands, a frame each), and by the preview, one
-//! sample per block (docs/commands.md#lookdev-bench---device-name---spp-n---passes-n---aov-name---interactive---edits-n).
+//! sample per block. See
+//! docs/commands.md#lookdev-bench---device-name---spp-n---passes-n---aov-name---interactive---edits-n.
 
 use super::bench::BenchArgs;
 use crate::render::scene::{GBufferSpec, Scene, SceneSpec};
