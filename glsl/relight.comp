@@ -6,6 +6,10 @@
 // by finalize.comp, so background pixels cost nothing after the first pass of an accumulation.
 // Every pixel of a band has the same number of samples so far; keeping that number (and so the
 // branches below) uniform across the dispatch matters on SIMD CPU drivers.
+//
+// With block > 1 (the viewer's preview after a change) each invocation stands for a block × block
+// block of pixels: it writes the background of all of them and relights only the block's top-left
+// pixel, with the same sample 0 a full pass gives it, which overwrites it identically later.
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 16, local_size_y = 16) in;
@@ -57,6 +61,7 @@ layout(push_constant) uniform Pass {
     float intensity;
     uint first_row;        // the band this dispatch covers: rows first_row .. end_row - 1
     uint end_row;
+    uint block;            // pixels per side of the block one invocation covers: 1 for a full pass
 } pass;
 
 // R_y(−rotation)·d: world to environment space.
@@ -142,7 +147,8 @@ vec3 estimate_lobes(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec
 }
 
 void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.x, gl_GlobalInvocationID.y + pass.first_row);
+    int block = int(max(pass.block, 1u));
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.x, gl_GlobalInvocationID.y) * block + ivec2(0, pass.first_row);
     ivec2 size = imageSize(accumulation);
     if (pixel.x >= size.x || pixel.y >= int(pass.end_row)) {
         return;
@@ -152,11 +158,21 @@ void main() {
     vec3 view = imageLoad(surface, ivec3(pixel, 1)).xyz;
     if (pass.first_sample == 0u) {
         // The same for every pass, so computed once per accumulation.
-        vec3 behind = vec3(0.0);
-        if (pass.show_background != 0u && coverage < 1.0) {
-            behind = pass.intensity * env_background(env_direction_to_uv(to_environment(-view)));
+        for (int dy = 0; dy < block; dy++) {
+            for (int dx = 0; dx < block; dx++) {
+                ivec2 q = pixel + ivec2(dx, dy);
+                if (q.x >= size.x || q.y >= int(pass.end_row)) {
+                    continue;
+                }
+                float q_coverage = imageLoad(surface, ivec3(q, 0)).w;
+                vec3 behind = vec3(0.0);
+                if (pass.show_background != 0u && q_coverage < 1.0) {
+                    vec3 q_view = imageLoad(surface, ivec3(q, 1)).xyz;
+                    behind = pass.intensity * env_background(env_direction_to_uv(to_environment(-q_view)));
+                }
+                imageStore(background, q, vec4(behind, 0.0));
+            }
         }
-        imageStore(background, pixel, vec4(behind, 0.0));
     }
     if (coverage <= 0.0) {
         return;

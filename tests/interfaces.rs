@@ -19,6 +19,7 @@ fn interfaces() -> Vec<Interface> {
         lookdev::render::passes::resolve::INTERFACE,
         lookdev::render::passes::relight::INTERFACE,
         lookdev::render::passes::finalize::INTERFACE,
+        lookdev::render::passes::denoise::INTERFACE,
         lookdev::render::energy::INTERFACE,
         common::probes::BRDF_PROBE,
         common::probes::SAMPLE_PROBE,

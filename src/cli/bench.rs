@@ -24,11 +24,21 @@ pub struct BenchArgs {
     /// measure what they cost.
     #[arg(long = "aov", value_name = "NAME")]
     pub aovs: Vec<String>,
+    /// Instead of throughput, the viewer's wait after an edit: time from a change of the light
+    /// to a complete frame at the new state, by a first full pass and by the preview.
+    #[arg(long)]
+    pub interactive: bool,
+    /// With --interactive: how many edits (turns of the light) are timed.
+    #[arg(long, default_value_t = 12, value_name = "N")]
+    pub edits: u32,
 }
 
 const SIZES: [(u32, u32); 2] = [(512, 512), (1920, 1080)];
 
 pub fn run(args: BenchArgs) -> Result<()> {
+    if args.interactive {
+        return super::bench_interactive::run(&args);
+    }
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
     let info = ctx.info().clone();

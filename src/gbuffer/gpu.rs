@@ -14,7 +14,9 @@ pub struct GpuGBuffer {
     pub height: u32,
     /// Three layers: normal and coverage, view vector, tangent (`relight.comp`'s `surface`).
     pub surface: Image,
-    object_ids: Vec<u32>,
+    /// Each pixel's object id (R32_UINT), for the preview's and the display filter's edges.
+    pub object_ids: Image,
+    ids: Vec<u32>,
     /// The masks and maps by full channel name (`mask.stripes`, `map.baseColor.R`).
     channels: BTreeMap<String, Vec<f32>>,
     /// The channels the current stacks read, one layer each, with their names: kept while
@@ -31,13 +33,16 @@ impl GpuGBuffer {
         surface_data.extend(gbuffer.tangent.iter().map(|t| [t[0], t[1], t[2], 0.0]));
         let surface = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 3, true)?;
         surface.upload(ctx, bytemuck::cast_slice(&surface_data))?;
+        let object_ids = Image::new(ctx, vk::Format::R32_UINT, width, height, 1, false)?;
+        object_ids.upload(ctx, bytemuck::cast_slice(&gbuffer.object_id))?;
         let masks = gbuffer.masks.iter().map(|(name, values)| (format!("{MASK_PREFIX}{name}"), values.clone()));
         let maps = gbuffer.maps.iter().map(|(name, values)| (format!("{MAP_PREFIX}{name}"), values.clone()));
         Ok(GpuGBuffer {
             width,
             height,
             surface,
-            object_ids: gbuffer.object_id.clone(),
+            object_ids,
+            ids: gbuffer.object_id.clone(),
             channels: masks.chain(maps).collect(),
             channel_layers: None,
         })
@@ -46,8 +51,7 @@ impl GpuGBuffer {
     /// Each pixel's index into `packed`'s stacks, as an R32_UINT image.
     pub fn stack_index(&self, ctx: &Context, packed: &PackedStacks) -> Result<Image> {
         // Uncovered pixels may carry ids the stacks leave out; they shade nothing, so stack 0 does.
-        let index: Vec<u32> =
-            self.object_ids.iter().map(|id| packed.stack_of_object.get(id).copied().unwrap_or(0)).collect();
+        let index: Vec<u32> = self.ids.iter().map(|id| packed.stack_of_object.get(id).copied().unwrap_or(0)).collect();
         let image = Image::new(ctx, vk::Format::R32_UINT, self.width, self.height, 1, false)?;
         image.upload(ctx, bytemuck::cast_slice(&index))?;
         Ok(image)
@@ -57,7 +61,7 @@ impl GpuGBuffer {
     /// layer, so the binding is always valid); uploaded only when the list changes.
     pub fn channel_layers(&mut self, ctx: &Context, packed: &PackedStacks) -> Result<&Image> {
         if self.channel_layers.as_ref().is_none_or(|(names, _)| *names != packed.channels) {
-            let pixels = self.object_ids.len();
+            let pixels = self.ids.len();
             let layers = packed.channels.len().max(1) as u32;
             let mut data = vec![0.0f32; pixels * layers as usize];
             for (i, name) in packed.channels.iter().enumerate() {

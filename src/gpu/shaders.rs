@@ -34,8 +34,11 @@ pub const SAMPLE_PROBE: Kernel = kernel!("sample_probe");
 /// The energy-compensation table of a BRDF model.
 pub const ENERGY_TABLE: Kernel = kernel!("energy_table");
 
+/// The viewer's display filter: one iteration of an edge-avoiding à-trous wavelet filter.
+pub const DENOISE: Kernel = kernel!("denoise");
+
 /// Every kernel, with the GLSL file it is compiled from (`glsl/<name>.comp`).
-pub const ALL: [&Kernel; 6] = [&RESOLVE, &RELIGHT, &FINALIZE, &BRDF_PROBE, &SAMPLE_PROBE, &ENERGY_TABLE];
+pub const ALL: [&Kernel; 7] = [&RESOLVE, &RELIGHT, &FINALIZE, &BRDF_PROBE, &SAMPLE_PROBE, &ENERGY_TABLE, &DENOISE];
 
 /// One graphics shader stage's SPIR-V, compiled from `glsl/<file>`.
 pub struct Stage {

@@ -1,6 +1,7 @@
 //! The relighting engine: g-buffer, environment and layer stacks on the GPU; resolve, progressive
 //! relight passes, and display transforms. Every command that renders drives it.
 
+use super::passes::denoise::DenoisePass;
 use super::passes::finalize::{FinalizePass, FinalizePush};
 use super::passes::relight::RelightPass;
 use super::passes::resolve::ResolvePass;
@@ -18,6 +19,9 @@ use ash::vk;
 
 pub use super::passes::relight::{Accumulate, RelightPush, LOBES};
 pub use super::passes::RESOLVED_LAYERS;
+
+/// The largest preview block: one relit pixel per 8 × 8.
+pub const MAX_PREVIEW_BLOCK: u32 = 8;
 
 /// How the environment lights the scene. Any change restarts accumulation.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,6 +59,11 @@ pub struct Renderer {
     /// Whether every row has had a pass since this renderer was made: until then, its display
     /// image holds rows it has not drawn (cleared when made, but not a picture of anything).
     passed: bool,
+    /// The block size of the current accumulation's preview, once one is made
+    /// ([`Renderer::render_preview`]): rows with no samples yet are shown from it.
+    preview: Option<u32>,
+    /// The display filter, made when first asked for.
+    denoise: Option<DenoisePass>,
 }
 
 impl Renderer {
@@ -88,6 +97,8 @@ impl Renderer {
             seed: 0,
             row_samples: vec![0; height as usize],
             passed: false,
+            preview: None,
+            denoise: None,
         })
     }
 
@@ -173,6 +184,7 @@ impl Renderer {
     /// Starts a new accumulation with everything unchanged.
     pub fn restart(&mut self) {
         self.row_samples.fill(0);
+        self.preview = None;
     }
 
     pub fn set_seed(&mut self, seed: u32) {
@@ -237,7 +249,39 @@ impl Renderer {
         Ok(total)
     }
 
+    /// Relights the top-left pixel of every `block` × `block` block with sample 0 of the new
+    /// accumulation, and writes every pixel's background: the viewer's first, whole frame after
+    /// a change, at a `block`²-th of a pass's cost. Rows without samples are then shown from it
+    /// ([`Renderer::finalize_rows`]), interpolated within each object. The accumulation is left as
+    /// a pass will make it: the first pass writes the same sample 0 over those pixels, so the
+    /// preview changes no bits of any render. It must come before the first pass.
+    pub fn render_preview(&mut self, block: u32) -> Result<Option<f64>> {
+        assert!(self.resolve.has_stacks(), "set_stacks() must run before rendering");
+        if !(2..=MAX_PREVIEW_BLOCK).contains(&block) {
+            return Err(crate::Error::input(format!(
+                "a preview block is 2 to {MAX_PREVIEW_BLOCK} pixels, not {block}"
+            )));
+        }
+        if self.row_samples.iter().any(|&n| n > 0) {
+            return Err(crate::Error::gpu("a preview comes before the first pass of an accumulation"));
+        }
+        let time = self.dispatch(0, self.height, 0, 1, block)?;
+        // `passed` stays as it was: until a first pass, an A/B split's B half shows A, as it
+        // did before previews.
+        self.preview = Some(block);
+        Ok(time)
+    }
+
+    /// The block size of the current accumulation's preview, if one was made.
+    pub fn preview_block(&self) -> Option<u32> {
+        self.preview
+    }
+
     fn dispatch_relight(&self, first_row: u32, end_row: u32, first_sample: u32, count: u32) -> Result<Option<f64>> {
+        self.dispatch(first_row, end_row, first_sample, count, 1)
+    }
+
+    fn dispatch(&self, first_row: u32, end_row: u32, first_sample: u32, count: u32, block: u32) -> Result<Option<f64>> {
         let rotation = self.lighting.rotation_degrees.to_radians();
         let push = RelightPush {
             first_sample,
@@ -249,6 +293,7 @@ impl Renderer {
             intensity: self.lighting.intensity,
             first_row,
             end_row,
+            block,
         };
         self.timed(|renderer, cmd| renderer.relight.record(cmd, renderer.width, &push))
     }
@@ -262,16 +307,29 @@ impl Renderer {
     }
 
     /// Records finalize.comp over rows `first_row..first_row + rows`: the linear radiance image
-    /// and the display pixels of the current sums.
+    /// and the display pixels of the current sums. Rows with no samples yet are made from the
+    /// preview, when there is one; a dispatch per run of rows of either kind.
     pub fn record_finalize(&self, cmd: vk::CommandBuffer, first_row: u32, rows: u32, exposure: f32, tonemap: Tonemap) {
-        let push = FinalizePush {
-            exposure_scale: exposure.exp2(),
-            tonemap: tonemap.gpu_id(),
-            show_background: self.lighting.background as u32,
-            first_row,
-            end_row: first_row + rows.min(self.height.saturating_sub(first_row)),
+        let end = first_row + rows.min(self.height.saturating_sub(first_row));
+        let block_of = |row: u32| match self.preview {
+            Some(block) if self.row_samples[row as usize] == 0 => block,
+            _ => 1,
         };
-        self.finalize.record(cmd, self.width, &push);
+        let mut start = first_row;
+        while start < end {
+            let block = block_of(start);
+            let run_end = (start..end).find(|&r| block_of(r) != block).unwrap_or(end);
+            let push = FinalizePush {
+                exposure_scale: exposure.exp2(),
+                tonemap: tonemap.gpu_id(),
+                show_background: self.lighting.background as u32,
+                first_row: start,
+                end_row: run_end,
+                block,
+            };
+            self.finalize.record(cmd, self.width, &push);
+            start = run_end;
+        }
         crate::gpu::context::full_barrier(&self.ctx.shared.device, cmd);
     }
 
@@ -326,6 +384,44 @@ impl Renderer {
             Ok(())
         })?;
         Ok(staging.bytes()[..self.targets.display.byte_size() as usize].to_vec())
+    }
+
+    /// Filters the linear radiance as it stands (what [`Self::read_shown_display`] shows) with
+    /// the g-buffer-guided display filter, into [`Self::denoised_image`]. The accumulation and
+    /// the images saved are untouched.
+    pub fn denoise(&mut self, exposure: f32, tonemap: Tonemap) -> Result<()> {
+        if self.denoise.is_none() {
+            self.denoise = Some(DenoisePass::new(&self.ctx, &self.gbuffer, &self.targets)?);
+        }
+        let pass = self.denoise.as_ref().expect("just made");
+        let size = (self.width, self.height);
+        let background = self.lighting.background;
+        self.ctx.run(|cmd| {
+            pass.record(&self.ctx, cmd, size, exposure, tonemap, background);
+            Ok(())
+        })
+    }
+
+    /// The display filter's image (sRGB-encoded RGBA8), once [`Self::denoise`] has run.
+    pub fn denoised_image(&self) -> Option<&Image> {
+        self.denoise.as_ref().map(|d| &d.display)
+    }
+
+    /// The display filter's pixels, as [`Self::read_shown_display`] reads the unfiltered ones.
+    pub fn read_denoised(&self) -> Result<Vec<u8>> {
+        let image = self.denoised_image().ok_or_else(|| crate::Error::gpu("the display filter has not run"))?;
+        image.read(&self.ctx)
+    }
+
+    /// The display pixels as they stand, not remade: what the viewer shows now (a preview, or
+    /// rows a band of passes apart).
+    pub fn read_shown_display(&self) -> Result<Vec<u8>> {
+        self.targets.display.read(&self.ctx)
+    }
+
+    /// The linear radiance as it stands, not remade: the image behind [`Self::read_shown_display`].
+    pub fn read_shown_radiance(&self) -> Result<Vec<[f32; 4]>> {
+        Ok(bytemuck::cast_slice(&self.targets.radiance.read(&self.ctx)?).to_vec())
     }
 
     /// The running sums (rgb) and sample counts (a) of the covered pixels; uncovered pixels hold

@@ -80,6 +80,8 @@ pub enum Action {
     RestoreSnapshot(String),
     /// Deletes a snapshot and its files.
     DeleteSnapshot(String),
+    /// Shows the display filter (denoise) or not: what is shown only, never what is saved.
+    Denoise(bool),
 }
 
 /// What to show as B, beside the edited look (A).

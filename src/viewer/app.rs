@@ -30,6 +30,7 @@ use winit::window::{Window, WindowId};
 /// Opens the window and runs until it closes.
 pub fn run(options: ViewOptions) -> Result<()> {
     // Everything that can be wrong with the input is found before a window opens.
+    super::progressive::configure_budget()?;
     let inputs = Inputs::load(&options)?;
     let event_loop = EventLoop::new().map_err(super::no_display)?;
     let mut app = App { options, inputs: Some(inputs), running: None, outcome: Ok(()), validation: None };
@@ -495,6 +496,11 @@ impl Running {
                 self.session.delete_snapshot(&name)?;
                 return Ok(Some(format!("deleted snapshot {name}")));
             }
+            Action::Denoise(on) => {
+                self.session.set_denoise(on);
+                let state = if on { "on: the view is denoised; saved images are not" } else { "off" };
+                return Ok(Some(format!("display filter {state}")));
+            }
             Action::Answer(answer) => {
                 let pending = self.pending.take().ok_or_else(|| Error::input("there is no question to answer"))?;
                 match answer {
@@ -642,8 +648,11 @@ impl Running {
         let session = &self.session;
         let first =
             session.first_pass_after_change.map_or("n/a".to_string(), |d| format!("{:.0} ms", d.as_secs_f64() * 1e3));
+        let preview = session.progressive.preview.map_or("n/a".to_string(), |(d, block)| {
+            format!("{:.0} ms ({block}x{block} blocks)", d.as_secs_f64() * 1e3)
+        });
         format!(
-            "viewer: {}x{} on {}: {} spp; frame time while rendering {}; first full pass after the last change {first}; {:.1} M samples/s",
+            "viewer: {}x{} on {}: {} spp; frame time while rendering {}; preview after the last change {preview}; first full pass after it {first}; {:.1} M samples/s",
             session.width(),
             session.height(),
             session.device_name(),

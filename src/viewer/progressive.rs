@@ -1,23 +1,55 @@
 //! Progressive rendering bounded per frame: each frame relights a band of rows, sized from the
 //! measured speed so the frame stays responsive; a pass is done when the bands have swept the
 //! image. On a fast device a band is the whole image, so a change shows within one frame.
+//!
+//! The first frame after a change is a preview: one sample per 2×2, 4×4 (or, on a very slow
+//! device, 8×8) block, the smallest block that fits the frame's budget, interpolated to every
+//! pixel. So the whole image shows the new state at once, and the passes replace the preview
+//! band by band: no row ever shows the state before the change.
 
 use crate::render::Renderer;
 use crate::shading::tonemap::Tonemap;
 use crate::Result;
+use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 /// Relighting time allowed per frame, shared by the renderers on screen (two in an A/B split).
 pub const FRAME_BUDGET: Duration = Duration::from_millis(25);
+/// `LOOKDEV_FRAME_BUDGET_MS`: another budget, in milliseconds, so that a test can make any
+/// device sweep a pass over many frames, as a slow one does.
+const BUDGET_VARIABLE: &str = "LOOKDEV_FRAME_BUDGET_MS";
+static BUDGET: OnceLock<Duration> = OnceLock::new();
+
+/// Reads `LOOKDEV_FRAME_BUDGET_MS` (1 to 1000) once, before the window opens; a bad value is
+/// an error naming the variable.
+pub fn configure_budget() -> Result<()> {
+    let budget = match std::env::var(BUDGET_VARIABLE) {
+        Err(std::env::VarError::NotPresent) => FRAME_BUDGET,
+        Ok(text) => match text.trim().parse::<u64>() {
+            Ok(ms @ 1..=1000) => Duration::from_millis(ms),
+            _ => return Err(crate::Error::input(format!("{BUDGET_VARIABLE}={text}: expected 1 to 1000 milliseconds"))),
+        },
+        Err(e) => return Err(crate::Error::input(format!("{BUDGET_VARIABLE}: {e}"))),
+    };
+    let _ = BUDGET.set(budget);
+    Ok(())
+}
+
+/// The relighting time per frame: [`FRAME_BUDGET`] unless [`configure_budget`] read another.
+pub fn frame_budget() -> Duration {
+    BUDGET.get().copied().unwrap_or(FRAME_BUDGET)
+}
 /// The smallest band, so a slow device still makes progress each frame.
 const MIN_BAND_ROWS: u32 = 8;
 /// Samples per band once the first pass has landed: fewer, longer dispatches amortise each
 /// pass's per-pixel set-up, which on a CPU driver costs about as much as a sample.
 const SAMPLES_PER_BAND: u32 = 4;
+/// What a pixel's background costs in the preview, as a share of a relit sample.
+const PREVIEW_BACKGROUND_SHARE: f64 = 0.1;
 
 /// Where the sweep is, how fast rows relight, and the figures the status bar shows.
 pub struct Progressive {
-    /// This renderer's share of [`FRAME_BUDGET`].
+    /// This renderer's share of [`frame_budget`].
     budget: Duration,
     cursor: u32,
     /// Seconds to relight one row with one sample (a running average).
@@ -28,18 +60,21 @@ pub struct Progressive {
     /// Pixel samples relit, and the time spent, over the current accumulation.
     pixel_samples: f64,
     busy: Duration,
+    /// When the current accumulation's preview was shown, and its block size.
+    pub preview: Option<(Duration, u32)>,
 }
 
 impl Progressive {
     pub fn new() -> Progressive {
         Progressive {
-            budget: FRAME_BUDGET,
+            budget: frame_budget(),
             cursor: 0,
             row_seconds: 0.0,
             started: Instant::now(),
             first_pass: None,
             pixel_samples: 0.0,
             busy: Duration::ZERO,
+            preview: None,
         }
     }
 
@@ -55,16 +90,39 @@ impl Progressive {
         self.first_pass = None;
         self.pixel_samples = 0.0;
         self.busy = Duration::ZERO;
+        self.preview = None;
+    }
+
+    /// The preview's block: the smallest whose one sample per block is expected to fit the
+    /// budget at the measured speed, or 4 before anything is measured. Blocks of b × b relight
+    /// a b²-th of the pixels; every pixel's background costs about a tenth of a sample.
+    fn preview_block(&self, height: u32) -> u32 {
+        if self.row_seconds <= 0.0 {
+            return 4;
+        }
+        let fits = |block: u32| {
+            let rows = height as f64 / (block * block) as f64 + height as f64 * PREVIEW_BACKGROUND_SHARE;
+            rows * self.row_seconds <= self.budget.as_secs_f64()
+        };
+        [2, 4].into_iter().find(|&b| fits(b)).unwrap_or(crate::render::renderer::MAX_PREVIEW_BLOCK)
     }
 
     /// Relights the next band if the image has fewer than `target` samples, then makes its
-    /// display pixels. The first pass after a change takes one sample per band, so the whole
-    /// image changes soonest; later bands take a few. Returns whether anything was rendered.
+    /// display pixels. The first frame after a change is the preview instead; the first pass
+    /// takes one sample per band, so the preview is replaced soonest; later bands take a few.
+    /// Returns whether anything was rendered.
     pub fn step(&mut self, renderer: &mut Renderer, target: u32, exposure: f32, tonemap: Tonemap) -> Result<bool> {
         if renderer.samples() >= target {
             return Ok(false);
         }
         let height = renderer.height;
+        if renderer.preview_block().is_none() && (0..height).all(|row| renderer.row_samples(row) == 0) {
+            let block = self.preview_block(height);
+            renderer.render_preview(block)?;
+            renderer.finalize_rows(0, height, exposure, tonemap)?;
+            self.preview = Some((self.started.elapsed(), block));
+            return Ok(true);
+        }
         if renderer.row_samples(self.cursor) >= target {
             // The rows from here on are done (a completed pass caught them up): start over.
             self.cursor = 0;
@@ -108,6 +166,23 @@ impl Progressive {
             0.0
         } else {
             samples / busy.as_secs_f64()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_preview_block_is_the_smallest_that_fits_the_budget() {
+        let mut progressive = Progressive::new();
+        progressive.set_budget(Duration::from_millis(25));
+        assert_eq!(progressive.preview_block(1000), 4, "before any measurement");
+        // 1000 rows: 2×2 costs 250 + 100 row-samples, 4×4 62.5 + 100.
+        for (row_seconds, block) in [(50e-6, 2), (100e-6, 4), (1e-3, 8)] {
+            progressive.row_seconds = row_seconds;
+            assert_eq!(progressive.preview_block(1000), block, "{row_seconds} s a row");
         }
     }
 }

@@ -64,7 +64,7 @@ impl LayerChange {
 const COMMANDS: &str = "select, set, reset, map, add, remove, duplicate, move, show, hide, mask, invert, opacity, \
     rotate, intensity, background, env, exposure, tonemap, spp, seed, undo, redo, pick, inspect, wait-spp, save-look, \
     save-preset, save-image, screenshot, open-look, quit, answer, compare, divider, key, zoom, view, clipping, probe, \
-    snapshot, restore, delete-snapshot";
+    snapshot, restore, delete-snapshot, denoise";
 
 impl Script {
     pub fn load(path: &Path) -> Result<Script> {
@@ -368,6 +368,10 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
                 Action::DeleteSnapshot(name)
             }))
         }
+        "denoise" => {
+            arity(1)?;
+            Ok(Step::Do(Action::Denoise(switch(args[0])?)))
+        }
         other => Err(format!("unknown command '{other}' (expected one of: {COMMANDS})")),
     }
 }
@@ -577,5 +581,18 @@ mod tests {
             LayerChange::Reset(Param::Sheen).edit(object, 1),
             Edit::ResetParam { object, layer: 1, param: Param::Sheen }
         );
+    }
+
+    #[test]
+    fn denoise_parses_to_the_display_filter_switch() {
+        let script = parse("denoise on\ndenoise off\n").unwrap();
+        assert_eq!(script.steps[0].1, Step::Do(Action::Denoise(true)));
+        assert_eq!(script.steps[1].1, Step::Do(Action::Denoise(false)));
+        for (line, problem) in
+            [("denoise", "'denoise' takes 1 argument"), ("denoise maybe", "'maybe' is not on or off")]
+        {
+            let message = parse(line).unwrap_err().to_string();
+            assert!(message.contains(problem), "{line}: {message}");
+        }
     }
 }

@@ -5,7 +5,7 @@
 
 use super::compare::{self, Compare, SnapshotView, Subject};
 use super::delta_e::DeltaE;
-use super::progressive::{Progressive, FRAME_BUDGET};
+use super::progressive::{frame_budget, Progressive};
 use super::snapshots::{Capture, Snapshots};
 use crate::environment::{self, Environment, LoadOptions};
 use crate::gbuffer::GBuffer;
@@ -130,6 +130,11 @@ pub struct Session {
     pub snapshots: Snapshots,
     /// The snapshot shown as B, instead of a live renderer.
     snapshot_compare: Option<SnapshotCompare>,
+    /// Whether the display filter (denoise) is shown instead of the accumulation's own pixels.
+    pub denoise: bool,
+    /// The sample count the display filter last ran at, `None` when it must run again (a
+    /// change, a preview, other display settings).
+    denoised_at: Option<u32>,
 }
 
 /// A snapshot as B: which, how, and its ΔE map against the live image when shown as one.
@@ -191,6 +196,8 @@ impl Session {
             divider: 0.5,
             snapshots: Snapshots::default(),
             snapshot_compare: None,
+            denoise: false,
+            denoised_at: None,
         })
     }
 
@@ -252,13 +259,43 @@ impl Session {
         self.target_override.unwrap_or(self.document.settings().spp)
     }
 
+    /// What the view shows: the display pixels, or with the display filter on, its pixels.
     pub fn display_image(&self) -> &Image {
-        self.renderer.display_image()
+        shown_image(&self.renderer, self.denoise)
     }
 
     /// B's display image, when comparing.
     pub fn compare_image(&self) -> Option<&Image> {
-        self.compare.as_ref().map(|b| b.renderer.display_image())
+        self.compare.as_ref().map(|b| shown_image(&b.renderer, self.denoise))
+    }
+
+    /// Turns the display filter on or off. It changes only what is shown: never the samples,
+    /// nor any saved image.
+    pub fn set_denoise(&mut self, on: bool) {
+        self.denoise = on;
+        self.denoised_at = None;
+    }
+
+    /// Runs the display filter when it is on and what it filters has changed: after a change
+    /// (on the preview), and as each whole pass lands, so that it, too, never shows a frame
+    /// half old, half new.
+    fn refresh_denoise(&mut self) -> Result<()> {
+        let samples = self.samples();
+        if !self.denoise || self.denoised_at == Some(samples) {
+            return Ok(());
+        }
+        let settings = self.document.settings();
+        let (exposure, tonemap) = (settings.exposure, settings.tonemap);
+        let shown = |r: &Renderer| r.preview_block().is_some() || r.samples() > 0;
+        if !shown(&self.renderer) {
+            return Ok(());
+        }
+        self.renderer.denoise(exposure, tonemap)?;
+        if let Some(b) = self.compare.as_mut().filter(|b| shown(&b.renderer)) {
+            b.renderer.denoise(exposure, tonemap)?;
+        }
+        self.denoised_at = Some(samples);
+        Ok(())
     }
 
     /// Whether B's image is ready to be shown: B has finished its first pass. Until then, B's
@@ -334,8 +371,8 @@ impl Session {
         // Its display image starts cleared and is not shown until its first pass has landed
         // (see `compare_ready`).
         let mut progressive = Progressive::new();
-        progressive.set_budget(FRAME_BUDGET / 2);
-        self.progressive.set_budget(FRAME_BUDGET / 2);
+        progressive.set_budget(frame_budget() / 2);
+        self.progressive.set_budget(frame_budget() / 2);
         self.snapshot_compare = None;
         self.retired.extend(self.compare.replace(Compare { subject, renderer, progressive, packed }));
         Ok(())
@@ -345,7 +382,7 @@ impl Session {
     pub fn compare_off(&mut self) {
         self.snapshot_compare = None;
         self.retired.extend(self.compare.take());
-        self.progressive.set_budget(FRAME_BUDGET);
+        self.progressive.set_budget(frame_budget());
     }
 
     /// Lets go of B sides that were replaced or turned off, once the GPU is done with them.
@@ -465,6 +502,7 @@ impl Session {
             self.progressive.restart();
             self.changed_at = Instant::now();
             self.first_pass_after_change = None;
+            self.denoised_at = None;
         }
         if restarted || material_changed {
             // The layer names and weights may change with no change to what is rendered.
@@ -478,6 +516,7 @@ impl Session {
             if let Some(b) = &self.compare {
                 b.renderer.finalize_rows(0, self.height(), settings.exposure, settings.tonemap)?;
             }
+            self.denoised_at = None;
         }
         Ok(())
     }
@@ -494,6 +533,7 @@ impl Session {
         if self.first_pass_after_change.is_none() && self.samples() > 0 {
             self.first_pass_after_change = Some(self.changed_at.elapsed());
         }
+        self.refresh_denoise()?;
         // The inspector's radiance follows the accumulation, read back at 1, 2, 4, … samples
         // and at the target rather than every frame.
         let samples = self.samples();
@@ -782,6 +822,14 @@ impl Session {
             self.snapshot_compare = None;
         }
         Ok(())
+    }
+}
+
+/// A renderer's display image, or its display filter's once that has run.
+fn shown_image(renderer: &Renderer, denoise: bool) -> &Image {
+    match renderer.denoised_image() {
+        Some(image) if denoise => image,
+        _ => renderer.display_image(),
     }
 }
 

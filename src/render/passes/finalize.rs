@@ -1,5 +1,6 @@
 //! The finalize pass (`finalize.comp`): each pixel's mean, composited over the background, as
-//! linear radiance and as display pixels (exposure, tone map, sRGB).
+//! linear radiance and as display pixels (exposure, tone map, sRGB); or, for the viewer's preview
+//! after a change, the same from one relit pixel per block, interpolated within each object.
 
 use super::{groups, Targets};
 use crate::gbuffer::gpu::GpuGBuffer;
@@ -10,8 +11,8 @@ use ash::vk;
 /// What `finalize.comp` and the host agree on.
 pub const INTERFACE: Interface = Interface::compute(&shaders::FINALIZE, &[&SET], Some(FinalizePush::GLSL));
 
-/// Set 0 of `finalize.comp`: accumulation, background, surface, radiance, display.
-pub const SET: [BindingKind; 5] = [BindingKind::StorageImage; 5];
+/// Set 0 of `finalize.comp`: accumulation, background, surface, radiance, display, object ids.
+pub const SET: [BindingKind; 6] = [BindingKind::StorageImage; 6];
 
 /// `Finalize` in finalize.comp.
 #[repr(C)]
@@ -25,14 +26,17 @@ pub struct FinalizePush {
     /// The band this dispatch covers: rows `first_row..end_row`.
     pub first_row: u32,
     pub end_row: u32,
+    /// 1: every pixel's own sums; more: a preview's, one relit pixel per block this wide.
+    pub block: u32,
 }
 
-crate::glsl_struct!(FinalizePush as "Finalize", 20 bytes {
+crate::glsl_struct!(FinalizePush as "Finalize", 24 bytes {
     exposure_scale @ 0,
     tonemap @ 4,
     show_background @ 8,
     first_row @ 12,
     end_row @ 16,
+    block @ 20,
 });
 
 pub struct FinalizePass {
@@ -51,6 +55,7 @@ impl FinalizePass {
                 Binding::Image(&gbuffer.surface),
                 Binding::Image(&targets.radiance),
                 Binding::Image(&targets.display),
+                Binding::Image(&gbuffer.object_ids),
             ],
         )?;
         Ok(FinalizePass { pipeline, set })

@@ -5,11 +5,13 @@
 //! - [`relight::RelightPass`]: progressive MIS image-based lighting, accumulated per pixel,
 //!   with what the AOVs need beside the total;
 //! - [`finalize::FinalizePass`]: the mean, composited over the background, as linear radiance
-//!   and as display pixels.
+//!   and as display pixels (or the viewer's preview, interpolated from one sample per block);
+//! - [`denoise::DenoisePass`]: the viewer's optional display filter of that radiance.
 //!
 //! They share the images in [`Targets`] and the g-buffer's surface image
 //! ([`crate::gbuffer::gpu::GpuGBuffer`]).
 
+pub mod denoise;
 pub mod finalize;
 pub mod relight;
 pub mod resolve;

@@ -47,9 +47,12 @@ pub struct RelightPush {
     /// The band this dispatch covers: rows `first_row..end_row`.
     pub first_row: u32,
     pub end_row: u32,
+    /// Pixels per side of the block one invocation covers: 1 for a pass, more for a preview,
+    /// which relights each block's top-left pixel only.
+    pub block: u32,
 }
 
-crate::glsl_struct!(RelightPush as "Pass", 36 bytes {
+crate::glsl_struct!(RelightPush as "Pass", 40 bytes {
     first_sample @ 0,
     sample_count @ 4,
     seed @ 8,
@@ -59,6 +62,7 @@ crate::glsl_struct!(RelightPush as "Pass", 36 bytes {
     intensity @ 24,
     first_row @ 28,
     end_row @ 32,
+    block @ 36,
 });
 
 /// What the relight kernel accumulates beside the total, for the AOVs that need it
@@ -138,10 +142,16 @@ impl RelightPass {
         Ok(())
     }
 
-    /// Records the pass over `width` pixels of the rows `push` names.
+    /// Records the pass over `width` pixels of the rows `push` names, one invocation per block.
     pub fn record(&self, cmd: vk::CommandBuffer, width: u32, push: &RelightPush) {
         let rows = push.end_row - push.first_row;
+        let block = push.block.max(1);
         let sets = [&self.set, &self.environment_set];
-        self.pipeline.dispatch(cmd, &sets, bytemuck::bytes_of(push), groups(width, rows));
+        self.pipeline.dispatch(
+            cmd,
+            &sets,
+            bytemuck::bytes_of(push),
+            groups(width.div_ceil(block), rows.div_ceil(block)),
+        );
     }
 }

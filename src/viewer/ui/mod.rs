@@ -26,6 +26,10 @@ use super::view_image::Views;
 use egui::{Key, KeyboardShortcut, Modifiers};
 use std::time::{Duration, Instant};
 
+/// What the display filter is, where it is offered and marked.
+const DENOISE_HINT: &str = "Shows the accumulation through an edge-avoiding filter guided by the g-buffer's normals, \
+    base colours and object ids. Only the view: saved images are never filtered.";
+
 /// How long a status message stays.
 const MESSAGE_TIME: Duration = Duration::from_secs(8);
 
@@ -193,6 +197,9 @@ impl Interface {
             if input.consume_key(Modifiers::NONE, Key::P) {
                 actions.push(Action::Snapshot(None));
             }
+            if input.consume_key(Modifiers::NONE, Key::D) {
+                actions.push(Action::Denoise(!frame.session.denoise));
+            }
         });
     }
 
@@ -256,6 +263,12 @@ impl Interface {
                     self.viewport.actual_pixels();
                 }
                 ui.separator();
+                let denoise =
+                    egui::Button::selectable(frame.session.denoise, "Denoise (display filter)").shortcut_text("D");
+                if ui.add(denoise).on_hover_text(DENOISE_HINT).clicked() {
+                    actions.push(Action::Denoise(!frame.session.denoise));
+                }
+                ui.separator();
                 views::menu(ui, frame.session, frame.views, actions);
             });
             ui.menu_button("Help", |ui| {
@@ -289,6 +302,17 @@ impl Interface {
                 ui.separator();
                 ui.label(format!("first pass {:.0} ms", first.as_secs_f64() * 1e3))
                     .on_hover_text("Time from the last change to a first full pass over the image");
+            }
+            if let Some((preview, block)) = session.progressive.preview {
+                ui.separator();
+                ui.label(format!("preview {:.0} ms", preview.as_secs_f64() * 1e3)).on_hover_text(format!(
+                    "Time from the last change to a whole frame at the new state, one sample per {block}×{block} block"
+                ));
+            }
+            if session.denoise {
+                ui.separator();
+                ui.label(egui::RichText::new("denoised · display filter").color(ui.visuals().warn_fg_color))
+                    .on_hover_text(DENOISE_HINT);
             }
             ui.separator();
             ui.label(format!("{}×{} · {}", session.width(), session.height(), session.device_name()));
