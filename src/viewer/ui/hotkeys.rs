@@ -52,6 +52,8 @@ pub fn show(ctx: &egui::Context, open: &mut bool) {
         .open(open)
         .collapsible(false)
         .resizable(false)
+        // Wide enough for the longest description on one line: a narrower sheet cut them off.
+        .min_width(720.0)
         .fade_in(false)
         .fade_out(false)
         .anchor(egui::Align2::CENTER_CENTER, [0.0, 0.0])
