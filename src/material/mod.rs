@@ -5,7 +5,7 @@ pub mod look;
 pub mod params;
 pub mod preset;
 pub mod stack;
-mod toml_input;
+pub(crate) mod toml_input;
 
 pub use look::Look;
 pub use params::{Param, Params, Value};

@@ -4,6 +4,7 @@
 //! that made it.
 
 use super::action::{Action, Answer, Compare};
+use super::environments::EnvironmentLibrary;
 use super::gui::Gui;
 use super::presenter::Presenter;
 use super::script::{ScriptRunner, Step};
@@ -11,6 +12,7 @@ use super::session::Session;
 use super::thumbnails::{self, Thumbnails};
 use super::ui::{FileDialog, FilePurpose, Frame, FrameFigures, Interface, Pending};
 use super::ViewOptions;
+use crate::environment::EnvironmentRef;
 use crate::gpu::context::{Presentation, ValidationCounter};
 use crate::gpu::{Context, ContextOptions};
 use crate::render::scene::{covered_object_ids, load_look_for, LookSource, Scene};
@@ -134,6 +136,7 @@ struct Running {
     gui: Gui,
     presenter: Presenter,
     thumbnails: Thumbnails,
+    environments: EnvironmentLibrary,
     session: Session,
     ctx: Context,
     window: Window,
@@ -172,6 +175,7 @@ impl Running {
         let presenter = Presenter::new(&ctx, surface, size.width, size.height)?;
         let gui = Gui::new(&ctx, &window, &presenter)?;
         let thumbnails = Thumbnails::new(&ctx, thumbnails::cache_dir())?;
+        let (environments, warning) = EnvironmentLibrary::load();
         inputs.scene.check_device(ctx.info())?;
         let Inputs { scene, document } = inputs;
         let mut session = Session::new(
@@ -195,6 +199,7 @@ impl Running {
             gui,
             presenter,
             thumbnails,
+            environments,
             session,
             ctx,
             window,
@@ -210,6 +215,10 @@ impl Running {
             next_repaint: None,
             quit: false,
         };
+        if let Some(warning) = warning {
+            crate::warn(&warning);
+            running.interface.tell(warning, true);
+        }
         running.update_title();
         running.window.request_redraw();
         Ok(running)
@@ -276,6 +285,7 @@ impl Running {
             compare_texture,
             pending: self.pending.as_ref(),
             figures: FrameFigures { frame: self.clock.recent_mean() },
+            environments: &self.environments,
         };
         let output =
             self.gui.run(&self.window, |ui| self.interface.show(ui, &frame, &mut self.thumbnails, &mut actions));
@@ -419,8 +429,15 @@ impl Running {
                 }
             }
             Action::OpenEnvironment(path) => {
-                self.session.load_environment(path.as_deref())?;
-                self.session.document.apply(Edit::SetEnvironment(path)).map_err(Error::input)?;
+                self.session.load_environment(path.as_ref())?;
+                self.session.document.apply(Edit::SetEnvironment(path.clone())).map_err(Error::input)?;
+                if let Some(reference) = &path {
+                    if let Err(e) = self.environments.opened(reference) {
+                        crate::warn(e.to_string());
+                        self.interface.tell(e.to_string(), true);
+                    }
+                    self.interface.refresh_environments();
+                }
             }
             Action::OpenLook(path) => {
                 if document.is_dirty() {
@@ -465,6 +482,23 @@ impl Running {
             }
             Action::Key(key, modifiers) => self.gui.press_key(key, modifiers),
             Action::Zoom(scale) => self.interface.viewport.zoom_to(scale),
+            Action::StepEnvironment(by) => {
+                let current = EnvironmentRef::or_default(self.session.document.settings().environment.as_ref());
+                let next = self.environments.step(&current, by).expect("the library lists the built-ins");
+                self.session.load_environment(Some(&next))?;
+                self.session.document.apply(Edit::SetEnvironment(Some(next.clone()))).map_err(Error::input)?;
+                return Ok(Some(format!("environment: {}", next.label())));
+            }
+            Action::AddEnvironmentFolder(folder) => {
+                let added = self.environments.add_folder(&folder)?;
+                self.interface.refresh_environments();
+                let verb = if added { "added" } else { "already in the library:" };
+                return Ok(Some(format!("{verb} {}", folder.display())));
+            }
+            Action::RemoveEnvironmentFolder(folder) => {
+                self.environments.remove_folder(&folder)?;
+                self.interface.refresh_environments();
+            }
             Action::Answer(answer) => {
                 let pending = self.pending.take().ok_or_else(|| Error::input("there is no question to answer"))?;
                 match answer {

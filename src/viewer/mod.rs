@@ -11,6 +11,7 @@
 mod action;
 mod app;
 mod compare;
+mod environments;
 mod gui;
 mod presenter;
 mod progressive;

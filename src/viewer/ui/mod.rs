@@ -8,6 +8,7 @@
 mod browser;
 mod compare;
 mod dialogs;
+mod environments;
 mod inspector;
 mod layers;
 mod lighting;
@@ -54,6 +55,8 @@ pub struct Frame<'a> {
     pub compare_texture: Option<egui::TextureId>,
     pub pending: Option<&'a Pending>,
     pub figures: FrameFigures,
+    /// The environment library, for its browser.
+    pub environments: &'a super::environments::EnvironmentLibrary,
 }
 
 /// The interface's own state: view, open windows, what is being typed.
@@ -66,6 +69,7 @@ pub struct Interface {
     pub message: Option<Message>,
     /// Where the image was drawn last frame, in window pixels.
     pub placement: Option<ImagePlacement>,
+    environments: environments::Browser,
 }
 
 impl Interface {
@@ -86,6 +90,11 @@ impl Interface {
         self.browser.refresh();
     }
 
+    /// The environment browser's list is stale (a folder added, a file opened).
+    pub fn refresh_environments(&mut self) {
+        self.environments.refresh();
+    }
+
     /// Lays out and runs one frame of the interface.
     pub fn show(&mut self, ui: &mut egui::Ui, frame: &Frame, thumbnails: &mut Thumbnails, actions: &mut Vec<Action>) {
         self.shortcuts(ui.ctx(), frame, actions);
@@ -104,7 +113,7 @@ impl Interface {
         });
         egui::Panel::right("light").default_size(300.0).show(ui, |ui| {
             scrolled().show(ui, |ui| {
-                lighting::show(ui, frame.session, &mut self.file_dialog, actions);
+                lighting::show(ui, frame.session, &mut self.file_dialog, &mut self.environments.open, actions);
                 ui.separator();
                 compare::show(ui, frame.session, &mut self.file_dialog, actions);
                 ui.separator();
@@ -117,6 +126,8 @@ impl Interface {
         });
         let ctx = ui.ctx().clone();
         self.browser.show(&ctx, frame.session, thumbnails, actions, &mut self.message);
+        let (library, dialog) = (frame.environments, &mut self.file_dialog);
+        self.environments.show(&ctx, frame.session, library, thumbnails, dialog, actions, &mut self.message);
         if let Some(form) = &mut self.save_preset {
             if !form.show(&ctx, actions) {
                 self.save_preset = None;
@@ -165,6 +176,13 @@ impl Interface {
             if input.consume_key(Modifiers::NONE, Key::Num1) {
                 self.viewport.actual_pixels();
             }
+            // As in Unity's Look Dev: the arrows step through the environment library.
+            if input.consume_key(Modifiers::NONE, Key::ArrowLeft) {
+                actions.push(Action::StepEnvironment(-1));
+            }
+            if input.consume_key(Modifiers::NONE, Key::ArrowRight) {
+                actions.push(Action::StepEnvironment(1));
+            }
         });
     }
 
@@ -195,6 +213,10 @@ impl Interface {
                 ui.separator();
                 if ui.button("Open environment…").clicked() {
                     self.file_dialog = Some(FileDialog::new(FilePurpose::OpenEnvironment));
+                }
+                if ui.button("Environments…").on_hover_text("The environment library (←/→ step through it)").clicked()
+                {
+                    self.environments.open = true;
                 }
                 ui.separator();
                 if ui.add(egui::Button::new("Quit").shortcut_text("Ctrl+Q")).clicked() {
