@@ -253,4 +253,30 @@ mod viewer {
         let stepped = environment_of(&case, "stepped.toml");
         assert!(matches!(stepped, Some(EnvironmentRef::Builtin(_))), "{stepped:?}");
     }
+
+    #[test]
+    fn the_browser_keeps_its_thumbnails_in_the_cache() {
+        let Some(case) = Case::new() else { return };
+        case.write("browse.script", "environments\nwait-spp 16\nscreenshot browser.png\n");
+        let run = || {
+            let output =
+                case.view(&["look.toml", "--script", "browse.script", "--spp", "16", "--exit-after-spp", "16"]);
+            assert_success(&output);
+            let mut files: Vec<_> = std::fs::read_dir(case.path("cache/lookdev/thumbnails"))
+                .unwrap()
+                .map(|e| {
+                    let e = e.unwrap();
+                    (e.file_name(), e.metadata().unwrap().modified().unwrap())
+                })
+                .collect();
+            files.sort();
+            files
+        };
+        let first = run();
+        assert!(!first.is_empty(), "the open browser rendered thumbnails into the cache");
+        let second = run();
+        for file in &first {
+            assert!(second.contains(file), "{file:?} was rendered again: {second:?}");
+        }
+    }
 }

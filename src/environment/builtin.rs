@@ -38,7 +38,7 @@ pub const BUILTINS: &[Builtin] = &[
     },
     Builtin {
         name: "interior",
-        description: "a room with wooden walls and large bright windows: warm",
+        description: "a furnished room lit through large windows: warm",
         bytes: include_bytes!("interior.exr"),
     },
     Builtin {

@@ -73,6 +73,8 @@ pub enum Action {
     AddEnvironmentFolder(PathBuf),
     /// Takes a folder out of the library.
     RemoveEnvironmentFolder(PathBuf),
+    /// Opens the environment browser (a script's `environments`).
+    ShowEnvironments,
 }
 
 /// What to show as B, beside the edited look (A).

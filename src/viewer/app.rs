@@ -499,6 +499,7 @@ impl Running {
                 self.environments.remove_folder(&folder)?;
                 self.interface.refresh_environments();
             }
+            Action::ShowEnvironments => self.interface.show_environments(),
             Action::Answer(answer) => {
                 let pending = self.pending.take().ok_or_else(|| Error::input("there is no question to answer"))?;
                 match answer {

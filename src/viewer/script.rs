@@ -209,6 +209,10 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
             arity(1)?;
             edit(Edit::SetBackground(switch(args[0])?))
         }
+        "environments" => {
+            arity(0)?;
+            Ok(Step::Do(Action::ShowEnvironments))
+        }
         "env" => Ok(Step::Do(match rest {
             "next" => Action::StepEnvironment(1),
             "prev" => Action::StepEnvironment(-1),

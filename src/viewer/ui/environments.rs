@@ -66,7 +66,12 @@ impl Browser {
                     }
                     refresh = ui.button("⟳").on_hover_text("Read the folders again").clicked();
                 });
-                ui.label(RichText::new("Click to light the look with it; ← and → step through the list.").weak());
+                ui.label(
+                    RichText::new(
+                        "Click to light the look with it; the Left and Right arrow keys step through the list.",
+                    )
+                    .weak(),
+                );
                 for problem in &listing.problems {
                     ui.colored_label(ui.visuals().warn_fg_color, problem);
                 }

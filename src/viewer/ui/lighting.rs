@@ -28,7 +28,11 @@ pub fn show(
         if ui.button("Open…").clicked() {
             *file_dialog = Some(FileDialog::new(FilePurpose::OpenEnvironment));
         }
-        if ui.button("Library…").on_hover_text("Browse the environments (←/→ step through them)").clicked() {
+        if ui
+            .button("Library…")
+            .on_hover_text("Browse the environments (the Left and Right arrow keys step through them)")
+            .clicked()
+        {
             *environments_open = true;
         }
     });

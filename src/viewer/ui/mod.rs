@@ -95,6 +95,10 @@ impl Interface {
         self.environments.refresh();
     }
 
+    pub fn show_environments(&mut self) {
+        self.environments.open = true;
+    }
+
     /// Lays out and runs one frame of the interface.
     pub fn show(&mut self, ui: &mut egui::Ui, frame: &Frame, thumbnails: &mut Thumbnails, actions: &mut Vec<Action>) {
         self.shortcuts(ui.ctx(), frame, actions);
@@ -214,7 +218,10 @@ impl Interface {
                 if ui.button("Open environment…").clicked() {
                     self.file_dialog = Some(FileDialog::new(FilePurpose::OpenEnvironment));
                 }
-                if ui.button("Environments…").on_hover_text("The environment library (←/→ step through it)").clicked()
+                if ui
+                    .button("Environments…")
+                    .on_hover_text("The environment library (the Left and Right arrow keys step through it)")
+                    .clicked()
                 {
                     self.environments.open = true;
                 }
