@@ -6,7 +6,6 @@ use super::super::action::Action;
 use super::super::environments::EnvironmentLibrary;
 use super::super::session::Session;
 use super::super::thumbnails::{self, Thumbnails};
-use super::dialogs::{FileDialog, FilePurpose};
 use super::Message;
 use crate::environment::library::{Entry, Listing, Section};
 use crate::environment::{Builtin, EnvironmentRef};
@@ -32,19 +31,20 @@ impl Browser {
         self.listing = None;
     }
 
+    /// Shows the window while it is open; true when its Browse… asks for the folder dialog.
     pub fn show(
         &mut self,
         ctx: &egui::Context,
         session: &Session,
         library: &EnvironmentLibrary,
         thumbnails: &mut Thumbnails,
-        file_dialog: &mut Option<FileDialog>,
         actions: &mut Vec<Action>,
         message: &mut Option<Message>,
-    ) {
+    ) -> bool {
         if !self.open {
-            return;
+            return false;
         }
+        let mut browse = false;
         let listing = self.listing.get_or_insert_with(|| library.listing());
         let current = EnvironmentRef::or_default(session.document.settings().environment.as_ref());
         let mut open = self.open;
@@ -61,9 +61,7 @@ impl Browser {
                         actions.push(Action::AddEnvironmentFolder(PathBuf::from(self.folder.trim())));
                         self.folder.clear();
                     }
-                    if ui.button("Browse…").clicked() {
-                        *file_dialog = Some(FileDialog::new(FilePurpose::AddEnvironmentFolder));
-                    }
+                    browse = ui.button("Browse…").clicked();
                     refresh = ui.button("⟳").on_hover_text("Read the folders again").clicked();
                 });
                 ui.label(
@@ -113,6 +111,7 @@ impl Browser {
         if refresh {
             self.refresh();
         }
+        browse
     }
 }
 

@@ -136,7 +136,8 @@ mod tests {
         let mut out = Vec::new();
         for _ in 0..2 {
             // The second pass lays out with the sizes the first measured.
-            let output = ctx.run_ui(egui::RawInput::default(), |ui| show(ui, session, &mut None, &mut actions));
+            let output =
+                ctx.run_ui(egui::RawInput::default(), |ui| show(ui, session, &mut None, &mut false, &mut actions));
             out.clear();
             output.shapes.iter().for_each(|clipped| texts(&clipped.shape, &mut out));
         }

@@ -130,8 +130,10 @@ impl Interface {
         });
         let ctx = ui.ctx().clone();
         self.browser.show(&ctx, frame.session, thumbnails, actions, &mut self.message);
-        let (library, dialog) = (frame.environments, &mut self.file_dialog);
-        self.environments.show(&ctx, frame.session, library, thumbnails, dialog, actions, &mut self.message);
+        let library = frame.environments;
+        if self.environments.show(&ctx, frame.session, library, thumbnails, actions, &mut self.message) {
+            self.file_dialog = Some(FileDialog::new(FilePurpose::AddEnvironmentFolder));
+        }
         if let Some(form) = &mut self.save_preset {
             if !form.show(&ctx, actions) {
                 self.save_preset = None;
