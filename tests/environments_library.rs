@@ -174,6 +174,8 @@ mod viewer {
         let maps = case.path("maps");
         std::fs::create_dir_all(&maps).unwrap();
         write_map(&maps.join("mine.hdr"));
+        // Listed before mine.hdr, and not a map: stepping passes over it.
+        std::fs::write(maps.join("broken.hdr"), b"not a map").unwrap();
         write_map(&case.path("other.hdr"));
         let config = Config { environment_folders: vec![maps], recent_environments: Vec::new() };
         config.save(&case.path("config/lookdev/config.toml")).unwrap();
@@ -194,7 +196,7 @@ mod viewer {
              save-look stepped.toml\nundo\nwait-spp 2\nscreenshot undone.png\nsave-look undone.toml\n\
              key ArrowLeft\nwait-spp 1\nsave-look left.toml\nenv studio\nkey ArrowLeft\nwait-spp 1\nsave-look wrapped.toml\nenv next\n\
              save-look next.toml\nenv prev\nenv prev\nsave-look prev.toml\nenv sunrise\nsave-look named.toml\n\
-             env other.hdr\n",
+             key ArrowRight\nwait-spp 1\nsave-look passed.toml\nenv other.hdr\n",
         );
         let output = case.view(&["look.toml", "--script", "step.script", "--exit-after-spp", "2"]);
         assert_success(&output);
@@ -210,6 +212,11 @@ mod viewer {
         assert_eq!(environment_of(&case, "next.toml"), builtin(0));
         assert_eq!(environment_of(&case, "prev.toml"), builtin(BUILTINS.len() - 1));
         assert_eq!(environment_of(&case, "named.toml"), Some(EnvironmentRef::Builtin("sunrise")));
+        assert_eq!(
+            environment_of(&case, "passed.toml"),
+            Some(EnvironmentRef::File(case.path("maps/mine.hdr"))),
+            "→ passes over the map that does not load"
+        );
         let saved = std::fs::read_to_string(case.path("stepped.toml")).unwrap();
         assert!(saved.contains(&format!("builtin = \"{}\"", BUILTINS[at + 1].name)), "{saved}");
 

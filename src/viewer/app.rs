@@ -483,11 +483,29 @@ impl Running {
             Action::Key(key, modifiers) => self.gui.press_key(key, modifiers),
             Action::Zoom(scale) => self.interface.viewport.zoom_to(scale),
             Action::StepEnvironment(by) => {
-                let current = EnvironmentRef::or_default(self.session.document.settings().environment.as_ref());
-                let next = self.environments.step(&current, by).expect("the library lists the built-ins");
-                self.session.load_environment(Some(&next))?;
-                self.session.document.apply(Edit::SetEnvironment(Some(next.clone()))).map_err(Error::input)?;
-                return Ok(Some(format!("environment: {}", next.label())));
+                // A map that does not load is passed over (and named), so one bad file in a
+                // folder does not stop the stepping there.
+                let mut at = EnvironmentRef::or_default(self.session.document.settings().environment.as_ref());
+                let mut skipped = Vec::new();
+                for _ in 0..self.environments.listing().order().len() {
+                    let next = self.environments.step(&at, by).expect("the library lists the built-ins");
+                    match self.session.load_environment(Some(&next)) {
+                        Ok(()) => {
+                            self.session
+                                .document
+                                .apply(Edit::SetEnvironment(Some(next.clone())))
+                                .map_err(Error::input)?;
+                            let mut note = format!("environment: {}", next.label());
+                            if !skipped.is_empty() {
+                                note.push_str(&format!(" (passed over: {})", skipped.join("; ")));
+                            }
+                            return Ok(Some(note));
+                        }
+                        Err(e) => skipped.push(e.to_string()),
+                    }
+                    at = next;
+                }
+                return Err(Error::input(format!("no environment loads: {}", skipped.join("; "))));
             }
             Action::AddEnvironmentFolder(folder) => {
                 let added = self.environments.add_folder(&folder)?;
