@@ -57,7 +57,7 @@ fn unknown_keys_name_the_table_and_the_expected_keys() {
     );
     assert_eq!(
         error("[environment]\nfile = \"a.exr\"\n\nrotaton = 3\n"),
-        "looks/shot.toml:4: unknown key 'rotaton' in [environment] (expected file, rotation, intensity, background); \
+        "looks/shot.toml:4: unknown key 'rotaton' in [environment] (expected file, builtin, rotation, intensity, background); \
          did you mean 'rotation'?"
     );
     assert_eq!(
