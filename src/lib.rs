@@ -8,6 +8,7 @@
 pub mod asset;
 pub mod atomic_file;
 pub mod cli;
+pub mod config;
 pub mod environment;
 pub mod error;
 pub mod gbuffer;

@@ -271,7 +271,7 @@ fn exr_layers_and_metadata_read_back() {
     assert_eq!(exr_text(&out, "lookdev/version").as_deref(), Some(env!("CARGO_PKG_VERSION")));
     assert_eq!(exr_text(&out, "lookdev/seed").as_deref(), Some("7"));
     assert_eq!(exr_text(&out, "lookdev/spp").as_deref(), Some("2"));
-    assert_eq!(exr_text(&out, "lookdev/environment").as_deref(), Some("built-in studio"));
+    assert_eq!(exr_text(&out, "lookdev/environment").as_deref(), Some("built-in city"));
     assert_eq!(exr_text(&out, "lookdev/environmentHash").map(|h| h.len()), Some(16));
     assert!(exr_text(&out, "lookdev/model").is_some_and(|m| !m.is_empty()));
     let look_text = exr_text(&out, "lookdev/look").unwrap();

@@ -344,6 +344,9 @@ fn blender_renders_relight_like_cycles_and_decode_like_the_specification() {
                 gbuffer,
                 "--look",
                 look,
+                // Blender lit the scene with the built-in studio's file.
+                "--env",
+                "builtin:studio",
                 "--rotation",
                 ROTATION,
                 "--spp",

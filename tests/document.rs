@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use lookdev::environment::EnvironmentRef;
 use lookdev::material::library;
 use lookdev::material::look::Look;
 use lookdev::material::params::{Param, Value};
@@ -92,7 +93,7 @@ fn every_kind_of_edit() -> Vec<Edit> {
         Edit::SetRotation(-40.0),
         Edit::SetIntensity(2.5),
         Edit::SetBackground(false),
-        Edit::SetEnvironment(Some("hdri/courtyard.exr".into())),
+        Edit::SetEnvironment(Some(EnvironmentRef::File("hdri/courtyard.exr".into()))),
         Edit::SetExposure(1.5),
         Edit::SetTonemap(Tonemap::Agx),
         Edit::SetTargetSpp(64),
@@ -214,7 +215,7 @@ fn failed_edits_change_nothing_and_record_nothing() {
         Edit::SetRotation(f32::INFINITY),
         Edit::SetIntensity(-1.0),
         Edit::SetIntensity(f32::NAN),
-        Edit::SetEnvironment(Some(PathBuf::new())),
+        Edit::SetEnvironment(Some(EnvironmentRef::File(PathBuf::new()))),
         Edit::SetExposure(64.5),
         Edit::SetExposure(f32::NAN),
         Edit::SetTargetSpp(0),
@@ -429,7 +430,7 @@ fn revisions_count_changes_and_material_revisions_count_stack_changes() {
     for edit in [
         Edit::SetExposure(2.0),
         Edit::SetTonemap(Tonemap::Aces),
-        Edit::SetEnvironment(Some("sky.exr".into())),
+        Edit::SetEnvironment(Some(EnvironmentRef::File("sky.exr".into()))),
         Edit::SetIntensity(3.0),
         Edit::SetBackground(false),
         Edit::SetTargetSpp(16),
@@ -525,7 +526,7 @@ fn a_saved_look_reads_back_equal_with_its_settings_and_leaves_no_temporary_files
     for edit in every_kind_of_edit() {
         doc.apply(edit).unwrap();
     }
-    doc.apply(Edit::SetEnvironment(Some(dir.path().join("hdri/courtyard.exr")))).unwrap();
+    doc.apply(Edit::SetEnvironment(Some(EnvironmentRef::File(dir.path().join("hdri/courtyard.exr"))))).unwrap();
     assert!(doc.is_dirty());
 
     assert_eq!(doc.save(None).unwrap(), path);

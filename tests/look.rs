@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use lookdev::environment::EnvironmentRef;
 use lookdev::material::library::{self, Library};
 use lookdev::material::look::Look;
 use lookdev::material::params::{Param, Params, Value};
@@ -56,7 +57,7 @@ fn unknown_keys_name_the_table_and_the_expected_keys() {
     );
     assert_eq!(
         error("[environment]\nfile = \"a.exr\"\n\nrotaton = 3\n"),
-        "looks/shot.toml:4: unknown key 'rotaton' in [environment] (expected file, rotation, intensity, background); \
+        "looks/shot.toml:4: unknown key 'rotaton' in [environment] (expected file, builtin, rotation, intensity, background); \
          did you mean 'rotation'?"
     );
     assert_eq!(
@@ -345,7 +346,7 @@ roughness = 0.125
 base_color = [1, 0.5, 0]
 "#;
     let look = Look::parse(text, Path::new(SHOT)).unwrap();
-    assert_eq!(look.environment.file.as_deref(), Some(Path::new("looks/../hdri/studio.exr")));
+    assert_eq!(look.environment.source, Some(EnvironmentRef::File("looks/../hdri/studio.exr".into())));
     assert_eq!(look.environment.rotation, Some(-30.0));
     assert_eq!(look.environment.intensity, Some(2.5));
     assert_eq!(look.environment.background, Some(false));

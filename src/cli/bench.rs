@@ -43,7 +43,10 @@ pub fn run(args: BenchArgs) -> Result<()> {
     let counter = ctx.validation_counter();
     let info = ctx.info().clone();
     println!("device: {} (subgroup size {})", info.name, info.subgroup_size);
-    println!("scene: built-in shader ball, built-in default look, embedded studio environment");
+    println!(
+        "scene: built-in shader ball, built-in default look, default environment ({})",
+        crate::environment::builtin::DEFAULT
+    );
     let aovs =
         crate::render::aov::Aov::parse_all(&args.aovs).map_err(|e| crate::Error::input(format!("--aov: {e}")))?;
     let accumulate = crate::render::aov::accumulate(&aovs);

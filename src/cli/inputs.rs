@@ -2,7 +2,7 @@
 //! `--set`, gathered in [`SceneArgs`] for `render`, `turntable` and `view`, and turned into
 //! the [`SceneSpec`] that [`crate::render::scene::Scene::load`] reads.
 
-use crate::environment::LoadOptions;
+use crate::environment::{EnvironmentRef, LoadOptions};
 use crate::gbuffer::source::{Channels, SourceOptions, Up};
 use crate::material::{Look, Param, Value};
 use crate::render::scene::{GBufferSpec, LookSource, SceneSpec, MAX_BUILTIN_SIDE};
@@ -126,9 +126,11 @@ impl GBufferArgs {
 /// The environment and how it lights the scene.
 #[derive(Args, Debug, Default)]
 pub struct LightingArgs {
-    /// Equirectangular environment (default: the look's, else the embedded studio).
-    #[arg(long, value_name = "FILE.exr|.hdr")]
-    pub env: Option<PathBuf>,
+    /// Equirectangular environment file, or a built-in's name (builtin:NAME, or NAME where no
+    /// such file exists): studio, courtyard, city, interior, sunrise. Default: the look's, else
+    /// the default built-in.
+    #[arg(long, value_name = "FILE.exr|.hdr|NAME", value_parser = EnvironmentRef::parse)]
+    pub env: Option<EnvironmentRef>,
     /// Environment rotation about +Y, in degrees.
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     pub rotation: Option<f32>,

@@ -6,11 +6,14 @@
 //! centre is −Z and u = 0.75 is +X. A rotation of `r` degrees turns the environment about +Y:
 //! lookups use `R_y(−r)·d`.
 
+pub mod builtin;
 pub mod distribution;
 pub mod gpu;
+pub mod library;
 pub mod load;
 pub mod sampling;
 
+pub use builtin::{Builtin, EnvironmentRef};
 pub use distribution::Distribution;
 pub use gpu::GpuEnvironment;
 pub use load::LoadOptions;
@@ -53,9 +56,6 @@ pub fn content_hash(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |hash, &b| (hash ^ b as u64).wrapping_mul(0x0100_0000_01b3))
 }
 
-/// The embedded default: studio.exr, CC0 by Greg Zaal (HDRI Haven), 1024×512, DWAB-compressed.
-const STUDIO_EXR: &[u8] = include_bytes!("studio.exr");
-
 impl Environment {
     /// An environment of these texels (already valid), its hash from them.
     pub fn new(width: u32, height: u32, texels: Vec<[f32; 3]>, source: impl Into<String>) -> Environment {
@@ -65,18 +65,12 @@ impl Environment {
 
     /// The built-in studio environment.
     pub fn studio() -> Environment {
-        let name = "built-in studio";
-        let (width, height, mut texels) =
-            load::read_exr_texels(STUDIO_EXR, name).expect("the embedded studio environment reads");
-        // DWAB is lossy: its ringing leaves three texels of this file a hair below zero. They are
-        // known and harmless, so they are zeroed here rather than reported on every run.
-        for v in texels.iter_mut().flatten() {
-            *v = v.max(0.0);
-        }
-        let mut studio = load::validate(width, height, texels, name, &LoadOptions::default())
-            .expect("the embedded studio environment is valid");
-        studio.content_hash = content_hash(STUDIO_EXR);
-        studio
+        Builtin::find("studio").expect("studio is built in").load()
+    }
+
+    /// The default environment: the one a look that names none is lit by.
+    pub fn default_builtin() -> Environment {
+        Builtin::default_one().load()
     }
 
     /// A constant environment, as used by furnace tests.

@@ -11,6 +11,7 @@ use serde::Deserialize;
 use super::library::Library;
 use super::params::{Param, Params, Value};
 use super::toml_input::{self as input, Field, Source};
+use crate::environment::EnvironmentRef;
 use crate::gbuffer::source::{Channels, SourceOptions, Up};
 use crate::shading::model::{Model, ModelValue};
 use crate::shading::tonemap::{Tonemap, MAX_EXPOSURE};
@@ -43,8 +44,9 @@ pub struct GBufferSettings {
 /// `[environment]`. `None` means "not set here": the caller's default applies.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct EnvironmentSettings {
-    /// The environment image, already resolved against the look file's folder.
-    pub file: Option<PathBuf>,
+    /// `builtin = "NAME"`, or `file`: the environment image, already resolved against the look
+    /// file's folder.
+    pub source: Option<EnvironmentRef>,
     /// Degrees about +Y.
     pub rotation: Option<f32>,
     /// Radiance scale, finite and ≥ 0.
@@ -308,10 +310,14 @@ impl Look {
     fn write_environment(&self, lines: &mut Vec<String>) {
         let env = &self.environment;
         let mut body = Vec::new();
-        if let Some(file) = &env.file {
-            let folder = self.file.as_deref().and_then(Path::parent).unwrap_or(Path::new(""));
-            let relative = file.strip_prefix(folder).unwrap_or(file);
-            body.push(format!("file = {}", input::quoted(&relative.to_string_lossy())));
+        match &env.source {
+            Some(EnvironmentRef::File(file)) => {
+                let folder = self.file.as_deref().and_then(Path::parent).unwrap_or(Path::new(""));
+                let relative = file.strip_prefix(folder).unwrap_or(file);
+                body.push(format!("file = {}", input::quoted(&relative.to_string_lossy())));
+            }
+            Some(EnvironmentRef::Builtin(name)) => body.push(format!("builtin = {}", input::quoted(name))),
+            None => {}
         }
         push_float(&mut body, "rotation", env.rotation);
         push_float(&mut body, "intensity", env.intensity);
@@ -482,6 +488,7 @@ struct GBufferFile {
 #[serde(deny_unknown_fields, expecting = "an [environment] table")]
 struct EnvironmentFile {
     file: Option<Field>,
+    builtin: Option<Field>,
     rotation: Option<Field>,
     intensity: Option<Field>,
     background: Option<Field>,
@@ -540,8 +547,15 @@ fn environment(src: &Source, raw: Option<EnvironmentFile>, folder: &Path) -> cra
     let Some(raw) = raw else {
         return Ok(EnvironmentSettings::default());
     };
+    let file = src.read("file", &raw.file, input::text)?.map(|f| EnvironmentRef::File(folder.join(f)));
+    let builtin = src.read("builtin", &raw.builtin, |key, value| {
+        EnvironmentRef::builtin(&input::text(key, value)?).map_err(|e| format!("{key}: {e}"))
+    })?;
+    if let (Some(_), Some(field)) = (&file, &raw.builtin) {
+        return Err(src.error(field.span(), "[environment] takes a file or a builtin, not both"));
+    }
     Ok(EnvironmentSettings {
-        file: src.read("file", &raw.file, input::text)?.map(|f| folder.join(f)),
+        source: file.or(builtin),
         rotation: src.read("rotation", &raw.rotation, input::number)?,
         intensity: src.read("intensity", &raw.intensity, intensity)?,
         background: src.read("background", &raw.background, input::boolean)?,

@@ -1,7 +1,7 @@
 //! The inputs of a render, read and validated before any GPU work starts: g-buffer, look (with
 //! its stacks packed for the objects present), environment and settings.
 
-use crate::environment::{self, Environment, LoadOptions};
+use crate::environment::{Environment, EnvironmentRef, LoadOptions};
 use crate::gbuffer::source::{Source, SourceOptions};
 use crate::gbuffer::GBuffer;
 use crate::material::stack::{unused_stack_warnings, PackedStacks};
@@ -67,7 +67,7 @@ impl Scene {
         };
         prepare_look(&mut look, &spec.sets)?;
         let settings = Settings::resolve(&look, &spec.overrides)?;
-        let environment = load_environment(settings.environment.as_deref(), &spec.env_options)?;
+        let environment = load_environment(settings.environment.as_ref(), &spec.env_options)?;
         let ReadGBuffer { gbuffer, name: gbuffer_name, claims } = read_gbuffer(&spec.gbuffer, &mut look, spec.quiet)?;
         claims.into_iter().for_each(crate::warn);
         let covered = covered_object_ids(&gbuffer);
@@ -158,12 +158,9 @@ pub fn look_warnings(look: &Look, covered: &[u32], gbuffer_name: &Path) -> Vec<S
     warnings
 }
 
-/// The environment a look's settings name, or the built-in studio.
-pub fn load_environment(path: Option<&Path>, options: &LoadOptions) -> Result<Environment> {
-    match path {
-        Some(path) => environment::load::load(path, options),
-        None => Ok(Environment::studio()),
-    }
+/// The environment a look's settings name, or the default built-in.
+pub fn load_environment(source: Option<&EnvironmentRef>, options: &LoadOptions) -> Result<Environment> {
+    EnvironmentRef::or_default(source).load(options)
 }
 
 /// A g-buffer as a render reads it.

@@ -1,11 +1,11 @@
 //! Render settings: the look's values, overridden by command-line flags, over the defaults.
 
 use super::Lighting;
+use crate::environment::EnvironmentRef;
 use crate::material::Look;
 use crate::shading::model::Model;
 use crate::shading::tonemap::{Tonemap, MAX_EXPOSURE};
 use crate::{Error, Result};
-use std::path::PathBuf;
 
 /// Samples per pixel when neither the look nor a flag says.
 pub const DEFAULT_SPP: u32 = 256;
@@ -13,7 +13,7 @@ pub const DEFAULT_SPP: u32 = 256;
 /// Values given on the command line; `None` leaves the look's value.
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
-    pub environment: Option<PathBuf>,
+    pub environment: Option<EnvironmentRef>,
     pub rotation: Option<f32>,
     pub intensity: Option<f32>,
     pub no_background: bool,
@@ -30,8 +30,8 @@ pub struct Overrides {
 /// Everything a render needs besides the g-buffer and the stacks.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
-    /// None: the embedded studio environment.
-    pub environment: Option<PathBuf>,
+    /// None: the default built-in environment.
+    pub environment: Option<EnvironmentRef>,
     pub lighting: Lighting,
     pub spp: u32,
     pub seed: u32,
@@ -79,7 +79,7 @@ impl Settings {
         Ok(Settings {
             aovs,
             model,
-            environment: overrides.environment.clone().or_else(|| env.file.clone()),
+            environment: overrides.environment.clone().or_else(|| env.source.clone()),
             lighting: Lighting {
                 rotation_degrees: finite("rotation", overrides.rotation.or(env.rotation).unwrap_or(0.0))?,
                 intensity,

@@ -2,6 +2,7 @@
 //! script reads them from a file; both are carried out by the same code, so a scripted test
 //! drives the real interface.
 
+use crate::environment::EnvironmentRef;
 use crate::viewer_state::{Edit, Selection};
 use std::path::PathBuf;
 
@@ -35,8 +36,8 @@ pub enum Action {
     /// Prints what the inspector shows now (a script's `inspect`), which follows edits, undo
     /// and accumulation.
     ShowInspection,
-    /// Loads an environment (`None`: the built-in studio) and makes it the look's.
-    OpenEnvironment(Option<PathBuf>),
+    /// Loads an environment (`None`: the default built-in) and makes it the look's.
+    OpenEnvironment(Option<EnvironmentRef>),
     /// Opens another look (asks first when there are unsaved edits).
     OpenLook(PathBuf),
     /// Saves the look, to its own file when `None`.
@@ -82,6 +83,15 @@ pub enum Action {
     DeleteSnapshot(String),
     /// Shows the display filter (denoise) or not: what is shown only, never what is saved.
     Denoise(bool),
+    /// Steps this many environments through the library (←/→, a script's `env next|prev`): an
+    /// undoable change of the look's environment, as `OpenEnvironment` makes.
+    StepEnvironment(i32),
+    /// Adds a folder of `.exr`/`.hdr` environments to the library (kept in the config file).
+    AddEnvironmentFolder(PathBuf),
+    /// Takes a folder out of the library.
+    RemoveEnvironmentFolder(PathBuf),
+    /// Opens the environment browser (a script's `environments`).
+    ShowEnvironments,
 }
 
 /// What to show as B, beside the edited look (A).

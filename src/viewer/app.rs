@@ -4,6 +4,7 @@
 //! that made it.
 
 use super::action::{Action, Answer, Compare};
+use super::environments::EnvironmentLibrary;
 use super::gui::Gui;
 use super::presenter::Presenter;
 use super::script::{ScriptRunner, Step};
@@ -12,6 +13,7 @@ use super::thumbnails::{self, Thumbnails};
 use super::ui::{FileDialog, FilePurpose, Frame, FrameFigures, Interface, Pending};
 use super::view_image::Views;
 use super::ViewOptions;
+use crate::environment::EnvironmentRef;
 use crate::gpu::context::{Presentation, ValidationCounter};
 use crate::gpu::{Context, ContextOptions};
 use crate::render::scene::{covered_object_ids, load_look_for, LookSource, Scene};
@@ -136,6 +138,7 @@ struct Running {
     gui: Gui,
     presenter: Presenter,
     thumbnails: Thumbnails,
+    environments: EnvironmentLibrary,
     session: Session,
     ctx: Context,
     window: Window,
@@ -175,6 +178,7 @@ impl Running {
         let presenter = Presenter::new(&ctx, surface, size.width, size.height)?;
         let gui = Gui::new(&ctx, &window, &presenter)?;
         let thumbnails = Thumbnails::new(&ctx, thumbnails::cache_dir())?;
+        let (environments, warning) = EnvironmentLibrary::load();
         inputs.scene.check_device(ctx.info())?;
         let Inputs { scene, document } = inputs;
         let mut session = Session::new(
@@ -198,6 +202,7 @@ impl Running {
             gui,
             presenter,
             thumbnails,
+            environments,
             session,
             ctx,
             window,
@@ -214,6 +219,10 @@ impl Running {
             quit: false,
             views: Views::default(),
         };
+        if let Some(warning) = warning {
+            crate::warn(&warning);
+            running.interface.tell(warning, true);
+        }
         running.update_title();
         running.window.request_redraw();
         Ok(running)
@@ -284,6 +293,7 @@ impl Running {
             pending: self.pending.as_ref(),
             figures: FrameFigures { frame: self.clock.recent_mean() },
             views: &self.views,
+            environments: &self.environments,
         };
         let output =
             self.gui.run(&self.window, |ui| self.interface.show(ui, &frame, &mut self.thumbnails, &mut actions));
@@ -429,8 +439,15 @@ impl Running {
                 }
             }
             Action::OpenEnvironment(path) => {
-                self.session.load_environment(path.as_deref())?;
-                self.session.document.apply(Edit::SetEnvironment(path)).map_err(Error::input)?;
+                self.session.load_environment(path.as_ref())?;
+                self.session.document.apply(Edit::SetEnvironment(path.clone())).map_err(Error::input)?;
+                if let Some(reference) = &path {
+                    if let Err(e) = self.environments.opened(reference) {
+                        crate::warn(e.to_string());
+                        self.interface.tell(e.to_string(), true);
+                    }
+                    self.interface.refresh_environments();
+                }
             }
             Action::OpenLook(path) => {
                 if document.is_dirty() {
@@ -501,6 +518,42 @@ impl Running {
                 let state = if on { "on: the view is denoised; saved images are not" } else { "off" };
                 return Ok(Some(format!("display filter {state}")));
             }
+            Action::StepEnvironment(by) => {
+                // A map that does not load is passed over (and named), so one bad file in a
+                // folder does not stop the stepping there.
+                let mut at = EnvironmentRef::or_default(self.session.document.settings().environment.as_ref());
+                let mut skipped = Vec::new();
+                for _ in 0..self.environments.listing().order().len() {
+                    let next = self.environments.step(&at, by).expect("the library lists the built-ins");
+                    match self.session.load_environment(Some(&next)) {
+                        Ok(()) => {
+                            self.session
+                                .document
+                                .apply(Edit::SetEnvironment(Some(next.clone())))
+                                .map_err(Error::input)?;
+                            let mut note = format!("environment: {}", next.label());
+                            if !skipped.is_empty() {
+                                note.push_str(&format!(" (passed over: {})", skipped.join("; ")));
+                            }
+                            return Ok(Some(note));
+                        }
+                        Err(e) => skipped.push(e.to_string()),
+                    }
+                    at = next;
+                }
+                return Err(Error::input(format!("no environment loads: {}", skipped.join("; "))));
+            }
+            Action::AddEnvironmentFolder(folder) => {
+                let added = self.environments.add_folder(&folder)?;
+                self.interface.refresh_environments();
+                let verb = if added { "added" } else { "already in the library:" };
+                return Ok(Some(format!("{verb} {}", folder.display())));
+            }
+            Action::RemoveEnvironmentFolder(folder) => {
+                self.environments.remove_folder(&folder)?;
+                self.interface.refresh_environments();
+            }
+            Action::ShowEnvironments => self.interface.show_environments(),
             Action::Answer(answer) => {
                 let pending = self.pending.take().ok_or_else(|| Error::input("there is no question to answer"))?;
                 match answer {

@@ -15,6 +15,7 @@ mod action;
 mod app;
 mod compare;
 mod delta_e;
+mod environments;
 mod gui;
 mod presenter;
 mod progressive;

@@ -6,6 +6,7 @@
 
 use super::action::{Action, Answer, Compare};
 use super::compare::SnapshotView;
+use crate::environment::EnvironmentRef;
 use crate::material::params::{parse_value, Param, Value};
 use crate::shading::tonemap::Tonemap;
 use crate::viewer_state::{Edit, ObjectRef, Selection};
@@ -210,7 +211,19 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
             arity(1)?;
             edit(Edit::SetBackground(switch(args[0])?))
         }
-        "env" => Ok(Step::Do(Action::OpenEnvironment(if rest == "studio" { None } else { Some(path()?) }))),
+        "environments" => {
+            arity(0)?;
+            Ok(Step::Do(Action::ShowEnvironments))
+        }
+        "env" => Ok(Step::Do(match rest {
+            "next" => Action::StepEnvironment(1),
+            "prev" => Action::StepEnvironment(-1),
+            "default" => Action::OpenEnvironment(None),
+            _ => {
+                path()?;
+                Action::OpenEnvironment(Some(EnvironmentRef::parse(rest)?))
+            }
+        })),
         "exposure" => {
             arity(1)?;
             edit(Edit::SetExposure(float(args[0])?))
@@ -458,7 +471,7 @@ mod tests {
         assert_eq!(*steps[3], Step::Do(Action::AddPresetLayer("gold".into())));
         assert_eq!(*steps[4], Step::Do(Action::SetMask(Some("stripes".into()))));
         assert_eq!(*steps[5], Step::Do(Action::Edit(Edit::SetRotation(-45.0))));
-        assert_eq!(*steps[6], Step::Do(Action::OpenEnvironment(None)));
+        assert_eq!(*steps[6], Step::Do(Action::OpenEnvironment(Some(EnvironmentRef::Builtin("studio")))));
         assert_eq!(*steps[7], Step::WaitSpp(4));
         assert_eq!(*steps[8], Step::Do(Action::SaveLook(Some(PathBuf::from("out/look.toml")))));
         assert_eq!(*steps[9], Step::Do(Action::Answer(Answer::Discard)));

@@ -7,7 +7,7 @@ use super::compare::{self, Compare, SnapshotView, Subject};
 use super::delta_e::DeltaE;
 use super::progressive::{frame_budget, Progressive};
 use super::snapshots::{Capture, Snapshots};
-use crate::environment::{self, Environment, LoadOptions};
+use crate::environment::{Environment, EnvironmentRef, LoadOptions};
 use crate::gbuffer::GBuffer;
 use crate::gpu::{Context, Image};
 use crate::material::params::Params;
@@ -28,7 +28,7 @@ const KEPT_ENVIRONMENTS: usize = 3;
 /// What the renderer was last given.
 struct Shown {
     material_revision: u64,
-    environment: Option<PathBuf>,
+    environment: Option<EnvironmentRef>,
     lighting: Lighting,
     seed: u32,
     exposure: f32,
@@ -110,7 +110,7 @@ pub struct Session {
     objects: Vec<u32>,
     masks: Vec<String>,
     env_options: LoadOptions,
-    environments: Vec<(Option<PathBuf>, Environment)>,
+    environments: Vec<(Option<EnvironmentRef>, Environment)>,
     shown: Shown,
     /// When the last change reached the renderer, and how long its first full pass took.
     changed_at: Instant,
@@ -416,19 +416,17 @@ impl Session {
         &self.ctx.info().name
     }
 
-    /// Loads an environment (or the built-in studio) and keeps it for [`Session::sync`]: called
-    /// before the edit that switches to it, so that a file that does not load changes nothing.
-    pub fn load_environment(&mut self, path: Option<&Path>) -> Result<()> {
-        let key = path.map(Path::to_path_buf);
+    /// Loads an environment (or the default built-in) and keeps it for [`Session::sync`]:
+    /// called before the edit that switches to it, so that a file that does not load changes
+    /// nothing.
+    pub fn load_environment(&mut self, source: Option<&EnvironmentRef>) -> Result<()> {
+        let key = source.cloned();
         if let Some(i) = self.environments.iter().position(|(p, _)| *p == key) {
             let entry = self.environments.remove(i);
             self.environments.push(entry);
             return Ok(());
         }
-        let environment = match path {
-            Some(path) => environment::load::load(path, &self.env_options)?,
-            None => Environment::studio(),
-        };
+        let environment = EnvironmentRef::or_default(source).load(&self.env_options)?;
         self.environments.push((key, environment));
         if self.environments.len() > KEPT_ENVIRONMENTS {
             // Never the one on screen: it may be needed again by an undo.
@@ -471,7 +469,7 @@ impl Session {
             self.shown.material_revision = self.document.material_revision();
         }
         if everything || settings.environment != self.shown.environment {
-            self.load_environment(settings.environment.as_deref())?;
+            self.load_environment(settings.environment.as_ref())?;
             let (_, environment) = self.environments.last().expect("just loaded");
             self.renderer.set_environment(environment)?;
             if let Some(b) = &mut self.compare {
@@ -664,7 +662,7 @@ impl Session {
     /// (the look's masks or environment do not fit), the old document stays.
     pub fn replace_document(&mut self, document: Document) -> Result<()> {
         PackedStacks::pack(document.look(), self.objects.iter().copied(), &self.gbuffer, &self.gbuffer_name)?;
-        self.load_environment(document.settings().environment.as_deref())?;
+        self.load_environment(document.settings().environment.as_ref())?;
         self.document = document;
         self.inspection = None;
         self.apply_changes(true)
@@ -811,7 +809,7 @@ impl Session {
         let (look, settings) = (snapshot.look.clone(), snapshot.settings.clone());
         PackedStacks::pack(&look, self.objects.iter().copied(), &self.gbuffer, &self.gbuffer_name)
             .map_err(|e| Error::input(format!("snapshot '{name}' cannot be restored: {e}")))?;
-        self.load_environment(settings.environment.as_deref())?;
+        self.load_environment(settings.environment.as_ref())?;
         Ok(crate::viewer_state::Edit::Restore { look: Box::new(look), settings: Box::new(settings) })
     }
 

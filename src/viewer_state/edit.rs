@@ -2,8 +2,8 @@
 //! state, so that an edit that fails has changed nothing.
 
 use std::fmt;
-use std::path::PathBuf;
 
+use crate::environment::EnvironmentRef;
 use crate::material::look::{EnvironmentSettings, Layer, Look, ObjectStack, RenderSettings};
 use crate::material::params::{Param, Params, Value};
 use crate::render::settings::{Settings, DEFAULT_SPP};
@@ -130,9 +130,9 @@ pub enum Edit {
     SetIntensity(f32),
     /// Whether background pixels show the environment.
     SetBackground(bool),
-    /// The environment image; `None` is the embedded studio environment. The file is not read
-    /// here: loading it is the viewer's job.
-    SetEnvironment(Option<PathBuf>),
+    /// The environment: a built-in or an image file; `None` is the default built-in. The file is
+    /// not read here: loading it is the viewer's job.
+    SetEnvironment(Option<EnvironmentRef>),
     /// Exposure in stops, within ±[`MAX_EXPOSURE`].
     SetExposure(f32),
     SetTonemap(Tonemap),
@@ -298,8 +298,8 @@ impl State {
             }
             Edit::SetBackground(background) => next.settings.lighting.background = background,
             Edit::SetEnvironment(file) => {
-                if file.as_ref().is_some_and(|f| f.as_os_str().is_empty()) {
-                    return Err("the environment file must not be empty (none is the studio environment)".to_string());
+                if file.as_ref().and_then(EnvironmentRef::file).is_some_and(|f| f.as_os_str().is_empty()) {
+                    return Err("the environment file must not be empty (none is the default environment)".to_string());
                 }
                 next.settings.environment = file;
             }
@@ -360,7 +360,7 @@ impl State {
         let s = &self.settings;
         let lighting = Lighting::default();
         self.look.environment = EnvironmentSettings {
-            file: s.environment.clone(),
+            source: s.environment.clone(),
             rotation: keep(env.rotation, s.lighting.rotation_degrees, lighting.rotation_degrees),
             intensity: keep(env.intensity, s.lighting.intensity, lighting.intensity),
             background: keep(env.background, s.lighting.background, lighting.background),

@@ -10,6 +10,7 @@ use std::path::{Component, Path, PathBuf};
 
 use super::edit::{check_layer, ObjectRef};
 use super::Document;
+use crate::environment::EnvironmentRef;
 use crate::material::library::{self, looks_like_path, Library};
 use crate::material::look::Look;
 use crate::material::params::{Param, Params};
@@ -36,7 +37,9 @@ impl Document {
             relocation.apply(&mut look);
         }
         // Held as the saved file will give it back, so that the two compare equal.
-        look.environment.file = look.environment.file.map(|env| folder.join(relative_path(&env, folder)));
+        if let Some(EnvironmentRef::File(env)) = &mut look.environment.source {
+            *env = folder.join(relative_path(env, folder));
+        }
         let text = look.to_toml();
         let reread = Look::parse(&text, &file).map_err(|e| Error::input(format!("not saved: {e}")))?;
         if reread != look {
@@ -46,7 +49,7 @@ impl Document {
 
         // From here on the document is the file, and every state undo can return to belongs to
         // the new place too.
-        self.state.settings.environment.clone_from(&reread.environment.file);
+        self.state.settings.environment.clone_from(&reread.environment.source);
         self.state.look = reread;
         for state in self.history.states_mut() {
             if let Some(relocation) = &relocation {

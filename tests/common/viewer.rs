@@ -75,7 +75,8 @@ impl Case {
             .env_remove("WAYLAND_DISPLAY")
             .env("LOOKDEV_VALIDATION", "1")
             .env("LOOKDEV_PRESETS", self.path("presets"))
-            .env("XDG_CACHE_HOME", self.path("cache"));
+            .env("XDG_CACHE_HOME", self.path("cache"))
+            .env("XDG_CONFIG_HOME", self.path("config"));
         command
     }
 

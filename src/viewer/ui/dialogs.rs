@@ -15,6 +15,8 @@ pub enum FilePurpose {
     OpenEnvironment,
     /// A look to show as B in the A/B split.
     CompareLook,
+    /// A folder for the environment library: the folder shown, or the one named.
+    AddEnvironmentFolder,
 }
 
 impl FilePurpose {
@@ -25,6 +27,7 @@ impl FilePurpose {
             FilePurpose::SaveImage => "Save image",
             FilePurpose::OpenEnvironment => "Open environment",
             FilePurpose::CompareLook => "Compare with look",
+            FilePurpose::AddEnvironmentFolder => "Add a folder of environments",
         }
     }
 
@@ -33,7 +36,7 @@ impl FilePurpose {
         match self {
             FilePurpose::OpenLook | FilePurpose::SaveLook | FilePurpose::CompareLook => &["toml"],
             FilePurpose::SaveImage => &["png", "exr"],
-            FilePurpose::OpenEnvironment => &["exr", "hdr"],
+            FilePurpose::OpenEnvironment | FilePurpose::AddEnvironmentFolder => &["exr", "hdr"],
         }
     }
 
@@ -46,8 +49,11 @@ impl FilePurpose {
             FilePurpose::OpenLook => Action::OpenLook(path),
             FilePurpose::SaveLook => Action::SaveLook(Some(path)),
             FilePurpose::SaveImage => Action::SaveImage(path),
-            FilePurpose::OpenEnvironment => Action::OpenEnvironment(Some(path)),
+            FilePurpose::OpenEnvironment => {
+                Action::OpenEnvironment(Some(crate::environment::EnvironmentRef::File(path)))
+            }
             FilePurpose::CompareLook => Action::Compare(super::super::action::Compare::Look(path)),
+            FilePurpose::AddEnvironmentFolder => Action::AddEnvironmentFolder(path),
         }
     }
 }
@@ -163,7 +169,11 @@ impl FileDialog {
                 ui.colored_label(ui.visuals().error_fg_color, problem);
             }
             ui.horizontal(|ui| {
-                let verb = if self.purpose.saving() { "Save" } else { "Open" };
+                let verb = match self.purpose {
+                    FilePurpose::AddEnvironmentFolder => "Add this folder",
+                    _ if self.purpose.saving() => "Save",
+                    _ => "Open",
+                };
                 if ui.button(verb).clicked() {
                     confirm = true;
                 }
@@ -172,7 +182,12 @@ impl FileDialog {
                 }
             });
         });
-        if confirm {
+        if confirm && self.purpose == FilePurpose::AddEnvironmentFolder {
+            // The folder shown, or a sub-folder named in the field.
+            let folder = self.chosen().filter(|p| p.is_dir()).unwrap_or_else(|| self.dir.clone());
+            actions.push(self.purpose.action(folder));
+            keep = false;
+        } else if confirm {
             match self.chosen() {
                 None => self.problem = Some("type a file name, or pick one".into()),
                 Some(path) if !self.purpose.saving() && !path.is_file() => {

@@ -24,6 +24,7 @@ pub const HOTKEYS: &[Hotkey] = &[
     Hotkey { keys: "E", does: "False-colour EV view on or off" },
     Hotkey { keys: "X", does: "Clipping overlay on or off" },
     Hotkey { keys: "P", does: "Take a snapshot of the image and its look" },
+    Hotkey { keys: "ArrowLeft / ArrowRight", does: "Previous / next environment in the library (an undoable edit)" },
     Hotkey { keys: "D", does: "Denoised display on or off (a display filter: never in saved images)" },
     Hotkey { keys: "?", does: "Show or hide this sheet" },
     Hotkey { keys: "Enter", does: "In a file dialog's name field: open or save that file" },

@@ -5,28 +5,35 @@ use super::super::action::Action;
 use super::super::session::Session;
 use super::dialogs::{FileDialog, FilePurpose};
 use super::viewport::wrap_degrees;
+use crate::environment::{Builtin, EnvironmentRef};
 use crate::shading::tonemap::Tonemap;
 use crate::viewer_state::Edit;
 
-pub fn show(ui: &mut egui::Ui, session: &Session, file_dialog: &mut Option<FileDialog>, actions: &mut Vec<Action>) {
+pub fn show(
+    ui: &mut egui::Ui,
+    session: &Session,
+    file_dialog: &mut Option<FileDialog>,
+    environments_open: &mut bool,
+    actions: &mut Vec<Action>,
+) {
     let settings = session.document.settings();
     ui.heading("Light");
-    let name = settings
-        .environment
-        .as_ref()
-        .map_or("studio (built-in)".to_string(), |p| p.file_name().unwrap_or(p.as_os_str()).to_string_lossy().into());
+    let current = EnvironmentRef::or_default(settings.environment.as_ref());
     ui.horizontal(|ui| {
-        ui.label(super::inspector::elide(&name)).on_hover_text(
-            settings
-                .environment
-                .as_ref()
-                .map_or("The embedded CC0 studio environment".into(), |p| p.display().to_string()),
-        );
+        let hover = match &current {
+            EnvironmentRef::Builtin(name) => Builtin::find(name).map_or(String::new(), |b| b.description.to_string()),
+            EnvironmentRef::File(path) => path.display().to_string(),
+        };
+        ui.label(super::inspector::elide(&current.label())).on_hover_text(hover);
         if ui.button("Open…").clicked() {
             *file_dialog = Some(FileDialog::new(FilePurpose::OpenEnvironment));
         }
-        if settings.environment.is_some() && ui.button("Studio").clicked() {
-            actions.push(Action::OpenEnvironment(None));
+        if ui
+            .button("Library…")
+            .on_hover_text("Browse the environments (the Left and Right arrow keys step through them)")
+            .clicked()
+        {
+            *environments_open = true;
         }
     });
     let lighting = settings.lighting;
@@ -129,7 +136,8 @@ mod tests {
         let mut out = Vec::new();
         for _ in 0..2 {
             // The second pass lays out with the sizes the first measured.
-            let output = ctx.run_ui(egui::RawInput::default(), |ui| show(ui, session, &mut None, &mut actions));
+            let output =
+                ctx.run_ui(egui::RawInput::default(), |ui| show(ui, session, &mut None, &mut false, &mut actions));
             out.clear();
             output.shapes.iter().for_each(|clipped| texts(&clipped.shape, &mut out));
         }

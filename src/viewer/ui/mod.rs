@@ -8,6 +8,7 @@
 mod browser;
 mod compare;
 mod dialogs;
+mod environments;
 pub mod hotkeys;
 mod inspector;
 mod layers;
@@ -64,6 +65,8 @@ pub struct Frame<'a> {
     pub figures: FrameFigures,
     /// The view shown instead of the beauty, its copy and textures.
     pub views: &'a Views,
+    /// The environment library, for its browser.
+    pub environments: &'a super::environments::EnvironmentLibrary,
 }
 
 /// The interface's own state: view, open windows, what is being typed.
@@ -79,6 +82,7 @@ pub struct Interface {
     /// The hotkey sheet is open.
     pub hotkeys: bool,
     snapshots: snapshots::Panel,
+    environments: environments::Browser,
 }
 
 impl Interface {
@@ -97,6 +101,15 @@ impl Interface {
     /// The library browser's list is stale (a preset was saved).
     pub fn refresh_library(&mut self) {
         self.browser.refresh();
+    }
+
+    /// The environment browser's list is stale (a folder added, a file opened).
+    pub fn refresh_environments(&mut self) {
+        self.environments.refresh();
+    }
+
+    pub fn show_environments(&mut self) {
+        self.environments.open = true;
     }
 
     /// Lays out and runs one frame of the interface.
@@ -118,7 +131,7 @@ impl Interface {
         });
         egui::Panel::right("light").default_size(300.0).show(ui, |ui| {
             scrolled().show(ui, |ui| {
-                lighting::show(ui, frame.session, &mut self.file_dialog, actions);
+                lighting::show(ui, frame.session, &mut self.file_dialog, &mut self.environments.open, actions);
                 ui.separator();
                 compare::show(ui, frame.session, &mut self.file_dialog, actions);
                 ui.separator();
@@ -141,6 +154,10 @@ impl Interface {
         });
         let ctx = ui.ctx().clone();
         self.browser.show(&ctx, frame.session, thumbnails, actions, &mut self.message);
+        let library = frame.environments;
+        if self.environments.show(&ctx, frame.session, library, thumbnails, actions, &mut self.message) {
+            self.file_dialog = Some(FileDialog::new(FilePurpose::AddEnvironmentFolder));
+        }
         if let Some(form) = &mut self.save_preset {
             if !form.show(&ctx, actions) {
                 self.save_preset = None;
@@ -200,6 +217,13 @@ impl Interface {
             if input.consume_key(Modifiers::NONE, Key::D) {
                 actions.push(Action::Denoise(!frame.session.denoise));
             }
+            // As in Unity's Look Dev: the arrows step through the environment library.
+            if input.consume_key(Modifiers::NONE, Key::ArrowLeft) {
+                actions.push(Action::StepEnvironment(-1));
+            }
+            if input.consume_key(Modifiers::NONE, Key::ArrowRight) {
+                actions.push(Action::StepEnvironment(1));
+            }
         });
     }
 
@@ -230,6 +254,13 @@ impl Interface {
                 ui.separator();
                 if ui.button("Open environment…").clicked() {
                     self.file_dialog = Some(FileDialog::new(FilePurpose::OpenEnvironment));
+                }
+                if ui
+                    .button("Environments…")
+                    .on_hover_text("The environment library (the Left and Right arrow keys step through it)")
+                    .clicked()
+                {
+                    self.environments.open = true;
                 }
                 ui.separator();
                 if ui.add(egui::Button::new("Quit").shortcut_text("Ctrl+Q")).clicked() {
