@@ -402,7 +402,7 @@ fn key_press(text: &str) -> std::result::Result<(egui::Key, egui::Modifiers), St
     for modifier in parts {
         match modifier.to_ascii_lowercase().as_str() {
             "shift" => modifiers.shift = true,
-            "ctrl" | "command" | "cmd" => modifiers = modifiers | egui::Modifiers::COMMAND,
+            "ctrl" | "command" | "cmd" => modifiers |= egui::Modifiers::COMMAND,
             "alt" => modifiers.alt = true,
             other => return Err(format!("unknown modifier '{other}' in '{text}' (expected shift, ctrl or alt)")),
         }
