@@ -64,20 +64,7 @@ fn the_filter_brings_a_few_samples_nearer_the_converged_image() {
 fn the_filter_does_not_blur_across_objects() {
     let ctx = common::gpu::context();
     let gbuffer = GBuffer::shaderball(SIZE, SIZE);
-    let look = look(
-        r#"
-        [[object]]
-        [[object.layer]]
-        [object.layer.set]
-        emission = [0.0, 0.8, 0.1]
-
-        [[object]]
-        id = 1
-        [[object.layer]]
-        [object.layer.set]
-        emission = [0.9, 0.05, 0.0]
-        "#,
-    );
+    let look = look(common::scenes::TWO_EMITTERS);
     let dark = Lighting { rotation_degrees: 0.0, intensity: 0.0, background: false };
     let mut r = renderer(&ctx, &gbuffer, &Environment::studio(), &look, dark);
     r.render_samples(1).unwrap();

@@ -114,17 +114,7 @@ fn environment_thumbnails_render_once_and_are_kept_on_disk() {
             first.push(image);
         }
     }
-    let kept = || {
-        let mut files: Vec<_> = std::fs::read_dir(dir.path())
-            .unwrap()
-            .map(|e| {
-                let e = e.unwrap();
-                (e.file_name(), e.metadata().unwrap().modified().unwrap())
-            })
-            .collect();
-        files.sort();
-        files
-    };
+    let kept = || cached_files(dir.path());
     let before = kept();
     assert_eq!(before.len(), SHIPPED.len(), "one file each: {before:?}");
     let (w, h) = thumbnails::ENVIRONMENT_SIZE;
@@ -155,6 +145,20 @@ fn environment_thumbnails_render_once_and_are_kept_on_disk() {
 }
 
 #[cfg(feature = "viewer")]
+/// The files in a thumbnail cache with their modification times, by name: what a session that
+/// renders nothing leaves as it was.
+fn cached_files(dir: &Path) -> Vec<(std::ffi::OsString, std::time::SystemTime)> {
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            (e.file_name(), e.metadata().unwrap().modified().unwrap())
+        })
+        .collect();
+    files.sort();
+    files
+}
+
 mod viewer {
     use super::common::viewer::*;
     use super::*;
@@ -269,15 +273,7 @@ mod viewer {
             let output =
                 case.view(&["look.toml", "--script", "browse.script", "--spp", "16", "--exit-after-spp", "16"]);
             assert_success(&output);
-            let mut files: Vec<_> = std::fs::read_dir(case.path("cache/lookdev/thumbnails"))
-                .unwrap()
-                .map(|e| {
-                    let e = e.unwrap();
-                    (e.file_name(), e.metadata().unwrap().modified().unwrap())
-                })
-                .collect();
-            files.sort();
-            files
+            super::cached_files(&case.path("cache/lookdev/thumbnails"))
         };
         let first = run();
         assert!(!first.is_empty(), "the open browser rendered thumbnails into the cache");

@@ -192,20 +192,7 @@ fn the_preview_keeps_each_object_to_its_own_colour() {
     let ctx = common::gpu::context();
     let gbuffer = ball();
     let env = Environment::studio();
-    let look = look(
-        r#"
-        [[object]]
-        [[object.layer]]
-        [object.layer.set]
-        emission = [0.0, 0.8, 0.1]
-
-        [[object]]
-        id = 1
-        [[object.layer]]
-        [object.layer.set]
-        emission = [0.9, 0.05, 0.0]
-        "#,
-    );
+    let look = look(common::scenes::TWO_EMITTERS);
     let dark = Lighting { rotation_degrees: 0.0, intensity: 0.0, background: false };
     let emission = |id: u32| if id == 1 { [0.9f32, 0.05, 0.0] } else { [0.0, 0.8, 0.1] };
     let block = 4i64;

@@ -35,6 +35,16 @@ pub struct BenchArgs {
 
 const SIZES: [(u32, u32); 2] = [(512, 512), (1920, 1080)];
 
+/// The built-in scene at `width`×`height`, with the default look and environment: what every
+/// benchmark measures.
+pub fn builtin_scene(width: u32, height: u32) -> Result<Scene> {
+    Scene::load(&SceneSpec {
+        gbuffer: GBufferSpec { builtin_size: Some((width, height)), ..GBufferSpec::default() },
+        quiet: true,
+        ..SceneSpec::default()
+    })
+}
+
 pub fn run(args: BenchArgs) -> Result<()> {
     if args.interactive {
         return super::bench_interactive::run(&args);
@@ -69,11 +79,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         format!("({} spp)", args.spp)
     );
     for (width, height) in SIZES {
-        let scene = Scene::load(&SceneSpec {
-            gbuffer: GBufferSpec { builtin_size: Some((width, height)), ..GBufferSpec::default() },
-            quiet: true,
-            ..SceneSpec::default()
-        })?;
+        let scene = builtin_scene(width, height)?;
         let gbuffer = &scene.gbuffer;
         let coverage = gbuffer.coverage.iter().filter(|&&a| a > 0.0).count() as f64 / gbuffer.pixel_count() as f64;
         let mut renderer = Renderer::new(&ctx, gbuffer, &scene.environment)?;

@@ -6,7 +6,6 @@
 //! docs/commands.md#lookdev-bench---device-name---spp-n---passes-n---aov-name---interactive---edits-n.
 
 use super::bench::BenchArgs;
-use crate::render::scene::{GBufferSpec, Scene, SceneSpec};
 use crate::render::{Lighting, Renderer};
 use crate::Result;
 use std::time::{Duration, Instant};
@@ -31,11 +30,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     );
     println!("{:>10}  {:<34} {:>12} {:>12}", "size", "complete frame by", "median", "95th pct");
     for (width, height) in SIZES {
-        let scene = Scene::load(&SceneSpec {
-            gbuffer: GBufferSpec { builtin_size: Some((width, height)), ..GBufferSpec::default() },
-            quiet: true,
-            ..SceneSpec::default()
-        })?;
+        let scene = super::bench::builtin_scene(width, height)?;
         let mut renderer = Renderer::new(&ctx, &scene.gbuffer, &scene.environment)?;
         renderer.set_stacks(&scene.stacks)?;
         let (exposure, tonemap) = (scene.settings.exposure, scene.settings.tonemap);

@@ -46,3 +46,18 @@ pub fn renderer(ctx: &Context, gbuffer: &GBuffer, env: &Environment, look: &Look
 pub fn look(text: &str) -> Look {
     Look::parse(text, Path::new("test-look.toml")).unwrap()
 }
+
+/// A look in which the ball (object 1) emits red and everything else green, under no light:
+/// each object's own colour, for tests of filters that must not mix objects.
+pub const TWO_EMITTERS: &str = r#"
+[[object]]
+[[object.layer]]
+[object.layer.set]
+emission = [0.0, 0.8, 0.1]
+
+[[object]]
+id = 1
+[[object.layer]]
+[object.layer.set]
+emission = [0.9, 0.05, 0.0]
+"#;
