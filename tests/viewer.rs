@@ -316,6 +316,24 @@ fn the_inspector_follows_edits_undo_and_accumulation() {
     assert_radiance_is_rendered(&case, converged, ball);
 }
 
+/// Between the first pass and the target the inspector keeps up: passes after the first add
+/// several samples each (1, 5, 9, …), stepping over the powers of two it was read back at, so
+/// after a change it stayed at its 1-spp reading until the target.
+#[test]
+fn the_inspector_keeps_up_with_accumulation_after_a_change() {
+    let Some(case) = Case::new() else { return };
+    let gbuffer = GBuffer::read(&case.path("g.exr")).unwrap();
+    let ball = half_striped_ball_pixel(&gbuffer);
+    let xy = format!("{} {}", ball as u32 % SIZE, ball as u32 / SIZE);
+    case.write("follow.script", &format!("wait-spp 1\npick {xy}\nrotate 30\nwait-spp 6\ninspect\n"));
+    let output = case.view(&["look.toml", "--script", "follow.script", "--spp", "64", "--exit-after-spp", "64"]);
+    assert_success(&output);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let line = stdout.lines().filter(|l| l.starts_with("lookdev: pixel")).nth(1).expect("inspect printed");
+    let spp: u32 = line.rsplit(" at ").next().and_then(|s| s.split(' ').next()).unwrap().parse().unwrap();
+    assert!((4..64).contains(&spp), "the inspector read back at {spp} spp after 6 were reached:\n{line}");
+}
+
 /// The panels keep their width whatever their values' widths: a four- and five-digit emission
 /// neither widens the layer panel nor moves or rescales the image.
 #[test]

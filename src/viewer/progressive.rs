@@ -41,6 +41,14 @@ pub fn frame_budget() -> Duration {
 }
 /// The smallest band, so a slow device still makes progress each frame.
 const MIN_BAND_ROWS: u32 = 8;
+
+/// Whether what was read back at `shown` samples should be read again at `now`: the count has
+/// reached the next power of two (1, 2, 4, …) since, or the target, or accumulation restarted.
+/// Passes after the first add several samples each, so the count steps over most powers of two
+/// (1, 5, 9, 13, …) rather than landing on them.
+pub fn read_again(shown: u32, now: u32, target: u32) -> bool {
+    now != shown && (now < shown || now >= target || now.checked_ilog2() > shown.checked_ilog2())
+}
 /// Samples per band once the first pass has landed: fewer, longer dispatches amortise each
 /// pass's per-pixel set-up, which on a CPU driver costs about as much as a sample.
 const SAMPLES_PER_BAND: u32 = 4;
@@ -173,6 +181,18 @@ impl Progressive {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn readings_follow_each_doubling_even_when_passes_step_over_it() {
+        assert!(read_again(0, 1, 16));
+        assert!(!read_again(1, 1, 16));
+        assert!(read_again(1, 5, 16), "5 passed 2 and 4");
+        assert!(!read_again(5, 7, 16));
+        assert!(read_again(5, 9, 16), "9 passed 8");
+        assert!(!read_again(9, 13, 16));
+        assert!(read_again(13, 16, 16), "the target");
+        assert!(read_again(16, 1, 16), "a restart");
+    }
 
     #[test]
     fn the_preview_block_is_the_smallest_that_fits_the_budget() {

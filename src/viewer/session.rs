@@ -535,8 +535,7 @@ impl Session {
         // The inspector's radiance follows the accumulation, read back at 1, 2, 4, … samples
         // and at the target rather than every frame.
         let samples = self.samples();
-        let behind = self.inspection.as_ref().is_some_and(|i| i.samples != samples);
-        if behind && (samples.is_power_of_two() || samples >= target) {
+        if self.inspection.as_ref().is_some_and(|i| super::progressive::read_again(i.samples, samples, target)) {
             self.refresh_inspection()?;
         }
         Ok(stepped)
@@ -772,7 +771,12 @@ impl Session {
             return Ok(());
         };
         let key = Some((samples, revision));
-        let due = shown.delta_key.is_none_or(|(_, r)| r != revision) || samples.is_power_of_two() || samples >= target;
+        let due = match shown.delta_key {
+            Some((shown_samples, shown_revision)) => {
+                shown_revision != revision || super::progressive::read_again(shown_samples, samples, target)
+            }
+            None => true,
+        };
         if samples == 0 || shown.delta_key == key || !due {
             return Ok(());
         }

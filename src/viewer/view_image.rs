@@ -160,7 +160,8 @@ impl Views {
         if !self.current.follows_samples() || samples == image.samples || samples == 0 {
             return false;
         }
-        samples.is_power_of_two() || samples >= session.target() || self.refreshed_at.elapsed() >= REFRESH
+        super::progressive::read_again(image.samples, samples, session.target())
+            || self.refreshed_at.elapsed() >= REFRESH
     }
 
     /// Whether the view's values can be read: a view that follows samples needs a full pass.
