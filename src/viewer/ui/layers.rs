@@ -378,14 +378,6 @@ mod tests {
     use crate::render::scene::{GBufferSpec, Scene, SceneSpec};
     use crate::viewer_state::Document;
 
-    fn texts(shape: &egui::Shape, out: &mut Vec<String>) {
-        match shape {
-            egui::Shape::Text(text) => out.push(text.galley.text().to_string()),
-            egui::Shape::Vec(shapes) => shapes.iter().for_each(|s| texts(s, out)),
-            _ => {}
-        }
-    }
-
     /// The panel shows the selected layer's parameters under their groups' headers, in the
     /// table's order: each name after its own header and before the next.
     #[test]
@@ -410,7 +402,7 @@ mod tests {
                 egui::ScrollArea::vertical().show(ui, |ui| show(ui, &session, &mut actions));
             });
             shown.clear();
-            output.shapes.iter().for_each(|clipped| texts(&clipped.shape, &mut shown));
+            output.shapes.iter().for_each(|clipped| super::super::shape_texts(&clipped.shape, &mut shown));
         }
         let at =
             |text: &str| shown.iter().position(|t| t == text).unwrap_or_else(|| panic!("no '{text}' in {shown:?}"));

@@ -120,15 +120,6 @@ mod tests {
     use crate::render::scene::{Scene, SceneSpec};
     use crate::viewer_state::Document;
 
-    /// Every piece of text the panel draws.
-    fn texts(shape: &egui::Shape, out: &mut Vec<String>) {
-        match shape {
-            egui::Shape::Text(text) => out.push(text.galley.text().to_string()),
-            egui::Shape::Vec(shapes) => shapes.iter().for_each(|s| texts(s, out)),
-            _ => {}
-        }
-    }
-
     /// The panel's text, drawn once in a headless egui context.
     fn panel_text(session: &Session) -> Vec<String> {
         let ctx = egui::Context::default();
@@ -139,7 +130,7 @@ mod tests {
             let output =
                 ctx.run_ui(egui::RawInput::default(), |ui| show(ui, session, &mut None, &mut false, &mut actions));
             out.clear();
-            output.shapes.iter().for_each(|clipped| texts(&clipped.shape, &mut out));
+            output.shapes.iter().for_each(|clipped| super::super::shape_texts(&clipped.shape, &mut out));
         }
         out
     }

@@ -359,3 +359,13 @@ impl Interface {
         });
     }
 }
+
+/// Every piece of text in a drawn shape, for tests that draw a panel in a headless egui context.
+#[cfg(test)]
+fn shape_texts(shape: &egui::Shape, out: &mut Vec<String>) {
+    match shape {
+        egui::Shape::Text(text) => out.push(text.galley.text().to_string()),
+        egui::Shape::Vec(shapes) => shapes.iter().for_each(|s| shape_texts(s, out)),
+        _ => {}
+    }
+}
