@@ -9,6 +9,8 @@ use std::path::PathBuf;
 pub enum Builtin {
     /// A shader ball on a pedestal, with stripe, grunge and gradient masks.
     Shaderball,
+    /// A unit sphere under an orthographic camera, filling most of the frame.
+    Sphere,
 }
 
 #[derive(Args, Debug)]
@@ -34,6 +36,9 @@ pub fn run(args: GbufferArgs) -> Result<()> {
     if !args.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
         return Err(Error::input_file(&args.out, "a g-buffer is written as an .exr file"));
     }
-    let Builtin::Shaderball = args.builtin;
-    GBuffer::shaderball(width, height).write(&args.out)
+    let gbuffer = match args.builtin {
+        Builtin::Shaderball => GBuffer::shaderball(width, height),
+        Builtin::Sphere => GBuffer::sphere(width, height),
+    };
+    gbuffer.write(&args.out)
 }

@@ -7,7 +7,8 @@
 //! (docs/formats.md#production-renders). [`GBuffer::write`] stores `N.*` (and `V.*`, `T.*` where
 //! the g-buffer has them) as float, `A`, masks and maps as half and `objectId` as uint,
 //! ZIP-compressed, through a temporary file renamed into place. [`GBuffer::shaderball`] makes the
-//! built-in scene (docs/formats.md#the-built-in-scene) without a file.
+//! built-in scene (docs/formats.md#the-built-in-scene) without a file, [`GBuffer::sphere`] the
+//! built-in orthographic sphere (docs/formats.md#the-built-in-sphere).
 
 mod frame;
 pub mod gpu;
@@ -16,6 +17,7 @@ mod read;
 mod scene;
 mod shaderball;
 pub mod source;
+mod sphere;
 mod validate;
 mod write;
 
@@ -25,6 +27,8 @@ pub use read::Read;
 /// Object ids of the built-in scene.
 pub use scene::{BALL_ID, PEDESTAL_ID};
 pub use source::{SourceOptions, Up};
+/// The built-in sphere's object ID and framing.
+pub use sphere::{SPHERE_FRAME_HALF_EXTENT, SPHERE_ID};
 
 use std::collections::BTreeMap;
 
