@@ -91,6 +91,12 @@ def rel_mse(image, reference, mask):
     return total / count
 
 
+def mean_radiance(image, mask):
+    """The mean of R + G + B over the masked pixels."""
+    covered = [p for p, keep in enumerate(mask) if keep]
+    return sum(sum(image[3 * p : 3 * p + 3]) for p in covered) / max(len(covered), 1)
+
+
 def efficiency(seconds, error):
     return 1.0 / (seconds * error) if seconds > 0 and error > 0 else float("inf")
 
@@ -398,7 +404,8 @@ def main():
                     theirs = (m_seconds, rel_mse(m_image, m_reference, coverage))
                     threads = f", {info['threads']} threads" if info["threads"] else ""
                     rows.append((name, f"Mitsuba {info['version']} (warm{threads})", *theirs))
-                    ratios.append((name, ours, theirs))
+                    agreement = mean_radiance(m_reference, coverage) / mean_radiance(reference, coverage)
+                    ratios.append((name, ours, theirs, agreement))
             print(f"  {name}: measured", flush=True)
         print()
         print_table(rows)
@@ -406,10 +413,11 @@ def main():
         if ratios:
             print()
             print("lookdev / Mitsuba:")
-            for name, (t, e), (mt, me) in ratios:
+            for name, (t, e), (mt, me), agreement in ratios:
                 print(
                     f"  {name}: time {t / mt:.2f}x, relMSE {e / me:.3g}x, "
-                    f"efficiency {efficiency(t, e) / efficiency(mt, me):.3g}x"
+                    f"efficiency {efficiency(t, e) / efficiency(mt, me):.3g}x "
+                    f"(the references' mean radiance, Mitsuba / lookdev: {agreement:.3f})"
                 )
     return 0
 

@@ -63,6 +63,9 @@ class RelMse(unittest.TestCase):
         with self.assertRaises(ValueError):
             compare_mitsuba.rel_mse([1.0] * 3, [1.0] * 3, [False])
 
+    def test_mean_radiance_counts_covered_pixels_only(self):
+        self.assertAlmostEqual(compare_mitsuba.mean_radiance([1, 2, 3, 9, 9, 9, 0, 0, 1], [True, False, True]), 3.5)
+
     def test_efficiency(self):
         self.assertAlmostEqual(compare_mitsuba.efficiency(0.5, 0.01), 200.0)
 
