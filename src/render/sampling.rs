@@ -13,8 +13,9 @@ pub enum Sampling {
     /// The environment sampled in proportion to its luminance, one environment and one BRDF
     /// sample combined by the power heuristic.
     Plain,
-    /// As `Plain`, with the environment sampled from max(L − mean, 0) (MIS compensation,
-    /// Karlík et al. 2019): the BRDF sample covers the dim part of the sphere.
+    /// As `Plain`, with the environment sampled from max(L − ½·mean, 0) (MIS compensation,
+    /// Karlík et al. 2019; see [`crate::environment::distribution::COMPENSATION`]): the BRDF
+    /// sample covers the dim part of the sphere.
     #[default]
     Compensated,
 }
