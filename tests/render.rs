@@ -6,7 +6,7 @@ mod common;
 
 use common::scenes::{look, orthographic_sphere, renderer};
 use glam::Vec3;
-use lookdev::environment::{Distribution, Environment};
+use lookdev::environment::Environment;
 use lookdev::gbuffer::GBuffer;
 use lookdev::material::stack::PackedStacks;
 use lookdev::material::{Look, Params};
@@ -245,7 +245,7 @@ fn relight_matches_the_cpu_mirror(ctx: &lookdev::gpu::Context, (gbuffer, look, s
     let reference = common::reference_render::Reference {
         gbuffer: &gbuffer,
         env: &env,
-        distribution: Distribution::build(&env),
+        distribution: r.sampling().distribution(&env, u32::MAX),
         lighting,
         seed,
     };

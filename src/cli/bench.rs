@@ -31,6 +31,13 @@ pub struct BenchArgs {
     /// With --interactive: how many edits (turns of the light) are timed.
     #[arg(long, default_value_t = 12, value_name = "N")]
     pub edits: u32,
+    /// Instead of throughput, each estimator's error against a high-spp reference, at equal
+    /// samples and at equal time (relMSE, time, efficiency), on the built-in scene at 256² or
+    /// on the g-buffer, look and environment given.
+    #[arg(long)]
+    pub convergence: bool,
+    #[command(flatten)]
+    pub convergence_args: super::bench_convergence::ConvergenceArgs,
 }
 
 const SIZES: [(u32, u32); 2] = [(512, 512), (1920, 1080)];
@@ -48,6 +55,9 @@ pub fn builtin_scene(width: u32, height: u32) -> Result<Scene> {
 pub fn run(args: BenchArgs) -> Result<()> {
     if args.interactive {
         return super::bench_interactive::run(&args);
+    }
+    if args.convergence {
+        return super::bench_convergence::run(&args);
     }
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();

@@ -166,6 +166,10 @@ pub struct SamplingArgs {
     /// (keys: diffuse, specular_d, specular_g, fresnel, gtr_gamma, energy_compensation).
     #[arg(long = "model", value_name = "KEY=VALUE")]
     pub model: Vec<String>,
+    /// The estimator: compensated (default) or plain; both unbiased, they differ in noise
+    /// (see `lookdev bench --convergence`).
+    #[arg(long, value_name = "NAME", value_parser = crate::render::sampling::Sampling::parse)]
+    pub sampling: Option<crate::render::sampling::Sampling>,
 }
 
 /// How linear radiance becomes PNG pixels.
@@ -192,6 +196,7 @@ fn overrides(lighting: &LightingArgs, sampling: &SamplingArgs, display: &Display
         tonemap: display.tonemap,
         model: sampling.model.clone(),
         aovs: Vec::new(),
+        sampling: sampling.sampling,
     }
 }
 

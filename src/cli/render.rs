@@ -69,6 +69,7 @@ fn render(ctx: &Context, scene: &Scene, aovs: &[Aov], label: &str, quiet: bool) 
     renderer.set_stacks(&scene.stacks)?;
     renderer.set_lighting(settings.lighting);
     renderer.set_seed(settings.seed);
+    renderer.set_sampling(settings.sampling, &scene.environment)?;
     let mut progress = Progress::new(settings.spp as u64, label, quiet);
     let stats = progressive::accumulate(&mut renderer, settings.spp, |done| progress.update(done as u64))?;
     progress.finish();

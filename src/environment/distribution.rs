@@ -18,6 +18,13 @@ use crate::shading::common::luminance;
 use glam::Vec3;
 use std::f64::consts::PI;
 
+/// The fraction of the mean luminance that compensated tables subtract (Karlík et al. 2019
+/// subtract all of it). Measured with `lookdev bench --convergence` on the five built-in maps,
+/// half the mean keeps the full subtraction's gain where it helps (studio, interior, courtyard)
+/// and loses nothing against plain tables on maps dominated by a small sun (sunrise, city),
+/// where the full subtraction lost up to 25% at 64 spp.
+pub const COMPENSATION: f64 = 0.5;
+
 /// At most this many cells a side. The tables then need images up to `MAX_CELLS + 1` texels a
 /// side; on a device whose image limit is lower, [`Distribution::for_device`] uses fewer cells.
 pub const MAX_CELLS: u32 = 4096;
@@ -151,14 +158,50 @@ impl Distribution {
 
     /// The tables with at most `max_cells` cells a side.
     pub fn with_max_cells(env: &Environment, max_cells: u32) -> Distribution {
+        Distribution::weighted(env, max_cells, false)
+    }
+
+    /// The MIS-compensated tables (Karlík et al. 2019) for a device whose images are at most
+    /// `max_image_side` texels a side: see [`Distribution::compensated_with_max_cells`].
+    pub fn compensated_for_device(env: &Environment, max_image_side: u32) -> Distribution {
+        Distribution::weighted(env, MAX_CELLS.min(max_image_side.saturating_sub(1)).max(1), true)
+    }
+
+    /// MIS-compensated tables: each texel weighs max(L − c·L̄, 0)·Ω instead of L·Ω, with L̄ the
+    /// mean luminance over the sphere (Σ L·Ω / 4π) and c = [`COMPENSATION`]. Under MIS with a
+    /// BRDF sample, whose pdf is positive wherever the BRDF is, the texels this leaves at pdf 0
+    /// are still covered, so the estimate stays unbiased; the environment samples go where the
+    /// map stands out, which the BRDF samples estimate poorly. A map that is constant up to
+    /// rounding gets the plain tables.
+    pub fn compensated_with_max_cells(env: &Environment, max_cells: u32) -> Distribution {
+        Distribution::weighted(env, max_cells, true)
+    }
+
+    fn weighted(env: &Environment, max_cells: u32, compensated: bool) -> Distribution {
         let (block_x, block_y) = (env.width.div_ceil(max_cells), env.height.div_ceil(max_cells));
         let (columns, rows) = (env.width.div_ceil(block_x), env.height.div_ceil(block_y));
-        let mut weights = vec![0.0f64; (columns * rows) as usize];
-        for y in 0..env.height {
-            let omega = 2.0 * PI / env.width as f64 * (row_cos(y, env.height) - row_cos(y + 1, env.height));
-            for x in 0..env.width {
-                let cell = ((y / block_y) * columns + x / block_x) as usize;
-                weights[cell] += luminance(Vec3::from(env.texel(x, y))).max(0.0) as f64 * omega;
+        let omegas: Vec<f64> = (0..env.height)
+            .map(|y| 2.0 * PI / env.width as f64 * (row_cos(y, env.height) - row_cos(y + 1, env.height)))
+            .collect();
+        let texel_weight = |x: u32, y: u32| luminance(Vec3::from(env.texel(x, y))).max(0.0) as f64;
+        let cell_weights = |offset: f64| {
+            let mut weights = vec![0.0f64; (columns * rows) as usize];
+            for y in 0..env.height {
+                for x in 0..env.width {
+                    let cell = ((y / block_y) * columns + x / block_x) as usize;
+                    weights[cell] += (texel_weight(x, y) - offset).max(0.0) * omegas[y as usize];
+                }
+            }
+            weights
+        };
+        let mut weights = cell_weights(0.0);
+        if compensated {
+            let mean = weights.iter().sum::<f64>() / (4.0 * PI);
+            let above = cell_weights(COMPENSATION * mean);
+            // A map constant up to rounding (where only rounding stands above the offset, at
+            // full compensation) keeps its plain tables.
+            if above.iter().sum::<f64>() > 1e-4 * mean * 4.0 * PI {
+                weights = above;
             }
         }
         Distribution::from_weights(env.width, env.height, block_x, block_y, &weights)
@@ -322,5 +365,26 @@ mod tests {
             assert!((sphere - 4.0 * PI).abs() < 1e-9, "{sphere}");
             assert!((probability - 1.0).abs() < 1e-5, "{probability}");
         }
+    }
+
+    /// Compensation samples only what stands above the offset, in proportion to the excess, and
+    /// leaves a map that is constant up to rounding with its plain tables.
+    #[test]
+    fn compensated_tables_weigh_the_excess_over_the_mean() {
+        // Two texel rows of equal solid angle: 1 and 3 on top, 0 and 4 below; the mean is 2.
+        let env = Environment::new(2, 2, vec![[1.0; 3], [3.0; 3], [0.0; 3], [4.0; 3]], "x");
+        let d = Distribution::compensated_with_max_cells(&env, 4096);
+        let omega = d.cell_solid_angle(0, 0);
+        let p: Vec<f64> = d.cell_pdf.iter().map(|&pdf| pdf as f64 * omega).collect();
+        let offset = COMPENSATION * 2.0;
+        let excess = [1.0f64, 3.0, 0.0, 4.0].map(|l| (l - offset).max(0.0));
+        let expected = excess.map(|e| e / excess.iter().sum::<f64>());
+        assert_eq!(expected[2], 0.0);
+        for (got, want) in p.iter().zip(expected) {
+            assert!((got - want).abs() < 1e-6, "{p:?}");
+        }
+        let uniform = Environment::uniform([0.5; 3], 8, 4);
+        let plain = Distribution::build(&uniform);
+        assert_eq!(Distribution::compensated_with_max_cells(&uniform, 4096).cell_pdf, plain.cell_pdf);
     }
 }

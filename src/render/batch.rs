@@ -19,6 +19,7 @@ pub struct Batch<'a> {
     renderer: Renderer,
     gbuffer: &'a GBuffer,
     gbuffer_name: &'a Path,
+    environment: &'a Environment,
 }
 
 impl<'a> Batch<'a> {
@@ -26,9 +27,9 @@ impl<'a> Batch<'a> {
         ctx: &Context,
         gbuffer: &'a GBuffer,
         gbuffer_name: &'a Path,
-        environment: &Environment,
+        environment: &'a Environment,
     ) -> Result<Batch<'a>> {
-        Ok(Batch { renderer: Renderer::new(ctx, gbuffer, environment)?, gbuffer, gbuffer_name })
+        Ok(Batch { renderer: Renderer::new(ctx, gbuffer, environment)?, gbuffer, gbuffer_name, environment })
     }
 
     pub fn width(&self) -> u32 {
@@ -48,6 +49,7 @@ impl<'a> Batch<'a> {
         self.renderer.set_model(&settings.model)?;
         self.renderer.set_lighting(settings.lighting);
         self.renderer.set_seed(settings.seed);
+        self.renderer.set_sampling(settings.sampling, self.environment)?;
         progressive::accumulate(&mut self.renderer, settings.spp, progress)?;
         Ok(())
     }

@@ -8,6 +8,7 @@ pub mod output;
 pub mod passes;
 pub mod progressive;
 pub mod renderer;
+pub mod sampling;
 pub mod scene;
 pub mod settings;
 pub mod sheet;

@@ -6,11 +6,12 @@ use super::passes::finalize::{FinalizePass, FinalizePush};
 use super::passes::relight::RelightPass;
 use super::passes::resolve::ResolvePass;
 use super::passes::Targets;
-use crate::environment::{Distribution, Environment, GpuEnvironment};
+use crate::environment::{Environment, GpuEnvironment};
 use crate::gbuffer::gpu::GpuGBuffer;
 use crate::gbuffer::GBuffer;
 use crate::gpu::{Buffer, Context, GpuTimer, Image};
 use crate::material::stack::PackedStacks;
+use crate::render::sampling::Sampling;
 use crate::shading::brdf::Shading;
 use crate::shading::model::Model;
 use crate::shading::tonemap::Tonemap;
@@ -64,6 +65,8 @@ pub struct Renderer {
     preview: Option<u32>,
     /// The display filter, made when first asked for.
     denoise: Option<DenoisePass>,
+    /// The estimator: which environment tables are uploaded.
+    sampling: Sampling,
 }
 
 impl Renderer {
@@ -78,7 +81,7 @@ impl Renderer {
         let gpu_gbuffer = GpuGBuffer::upload(ctx, gbuffer)?;
         let accumulate = Accumulate::default();
         let targets = Targets::new(ctx, width, height, accumulate)?;
-        let gpu_environment = upload_environment(ctx, environment)?;
+        let gpu_environment = upload_environment(ctx, environment, Sampling::default())?;
         let resolve = ResolvePass::new(ctx)?;
         let relight = RelightPass::new(ctx, model, accumulate, &gpu_gbuffer, &targets, &gpu_environment)?;
         let finalize = FinalizePass::new(ctx, &gpu_gbuffer, &targets)?;
@@ -99,12 +102,13 @@ impl Renderer {
             passed: false,
             preview: None,
             denoise: None,
+            sampling: Sampling::default(),
         })
     }
 
     /// Replaces the environment (its texels and sampling tables); accumulation restarts.
     pub fn set_environment(&mut self, environment: &Environment) -> Result<()> {
-        let gpu_environment = upload_environment(&self.ctx, environment)?;
+        let gpu_environment = upload_environment(&self.ctx, environment, self.sampling)?;
         self.relight.set_environment(&gpu_environment)?;
         self.environment = gpu_environment;
         self.restart();
@@ -481,10 +485,25 @@ impl Renderer {
     pub fn read_resolved(&self) -> Result<Vec<[f32; 4]>> {
         Ok(bytemuck::cast_slice(&self.targets.resolved.read(&self.ctx)?).to_vec())
     }
+
+    /// The estimator (docs/shading.md#sampling).
+    pub fn sampling(&self) -> Sampling {
+        self.sampling
+    }
+
+    /// Switches the estimator, with the tables it samples `environment` (the one being rendered)
+    /// by; accumulation restarts. Nothing happens when it is the same.
+    pub fn set_sampling(&mut self, sampling: Sampling, environment: &Environment) -> Result<()> {
+        if sampling == self.sampling {
+            return Ok(());
+        }
+        self.sampling = sampling;
+        self.set_environment(environment)
+    }
 }
 
-/// An environment with its sampling tables, on the GPU.
-fn upload_environment(ctx: &Context, environment: &Environment) -> Result<GpuEnvironment> {
-    let distribution = Distribution::for_device(environment, ctx.info().max_image_dimension_2d);
+/// An environment with the sampling tables `sampling` uses, on the GPU.
+fn upload_environment(ctx: &Context, environment: &Environment, sampling: Sampling) -> Result<GpuEnvironment> {
+    let distribution = sampling.distribution(environment, ctx.info().max_image_dimension_2d);
     GpuEnvironment::upload(ctx, environment, &distribution)
 }

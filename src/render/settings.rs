@@ -25,6 +25,8 @@ pub struct Overrides {
     pub model: Vec<String>,
     /// `--aov NAME`: when given, these AOVs instead of the look's `[render] aovs`.
     pub aovs: Vec<String>,
+    /// `--sampling NAME`: the estimator, instead of the default.
+    pub sampling: Option<crate::render::sampling::Sampling>,
 }
 
 /// Everything a render needs besides the g-buffer and the stacks.
@@ -41,6 +43,8 @@ pub struct Settings {
     pub model: Model,
     /// The AOVs to write beside the beauty.
     pub aovs: Vec<crate::render::aov::Aov>,
+    /// The estimator (docs/shading.md#sampling).
+    pub sampling: crate::render::sampling::Sampling,
 }
 
 impl Settings {
@@ -89,6 +93,7 @@ impl Settings {
             seed: overrides.seed.or(render.seed).unwrap_or(0),
             exposure,
             tonemap: overrides.tonemap.or(render.tonemap).unwrap_or_default(),
+            sampling: overrides.sampling.unwrap_or_default(),
         })
     }
 }

@@ -163,6 +163,7 @@ impl Session {
         let packed = PackedStacks::pack(document.look(), objects.iter().copied(), &gbuffer, &gbuffer_name)?;
         let settings = document.settings().clone();
         let mut renderer = Renderer::with_model(ctx, &gbuffer, &environment, &settings.model)?;
+        renderer.set_sampling(settings.sampling, &environment)?;
         renderer.set_stacks(&packed)?;
         renderer.set_lighting(settings.lighting);
         renderer.set_seed(settings.seed);
