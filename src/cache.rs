@@ -119,7 +119,13 @@ impl Entry {
             }
         };
         match self.parse(&bytes, key) {
-            Ok(payload) => payload,
+            // The payload is moved to the front of the file's buffer rather than copied out.
+            Ok(Some(start)) => Some({
+                let mut bytes = bytes;
+                bytes.drain(..start);
+                bytes
+            }),
+            Ok(None) => None,
             Err(problem) => {
                 damaged(path, problem);
                 None
@@ -127,9 +133,9 @@ impl Entry {
         }
     }
 
-    /// The payload of `bytes`: Ok(None) for a sound entry of another version or key, an error
-    /// for a damaged one.
-    fn parse(&self, bytes: &[u8], key: &[u8]) -> Result<Option<Vec<u8>>, &'static str> {
+    /// Where the payload of `bytes` starts: Ok(None) for a sound entry of another version or
+    /// key, an error for a damaged one.
+    fn parse(&self, bytes: &[u8], key: &[u8]) -> Result<Option<usize>, &'static str> {
         if bytes.len() < HEADER || &bytes[..8] != MAGIC {
             return Err("it is not a lookdev cache file");
         }
@@ -152,7 +158,7 @@ impl Entry {
         if version != self.version || &bytes[HEADER..HEADER + key_len] != key {
             return Ok(None);
         }
-        Ok(Some(payload.to_vec()))
+        Ok(Some(HEADER + key_len))
     }
 
     /// The whole file of an entry.
@@ -206,7 +212,8 @@ mod tests {
     #[test]
     fn an_entry_reads_back_only_whole_and_under_its_own_key_and_version() {
         let file = ENTRY.encode(b"key", b"payload");
-        assert_eq!(ENTRY.parse(&file, b"key"), Ok(Some(b"payload".to_vec())));
+        assert_eq!(ENTRY.parse(&file, b"key"), Ok(Some(file.len() - 7)));
+        assert_eq!(&file[file.len() - 7..], b"payload");
         assert_eq!(ENTRY.parse(&file, b"other key"), Ok(None));
         assert_eq!(Entry { version: 4, ..ENTRY }.parse(&file, b"key"), Ok(None));
         assert!(Entry { kind: "other", ..ENTRY }.parse(&file, b"key").is_err());
@@ -216,7 +223,8 @@ mod tests {
         for flip in 0..file.len() {
             let mut damaged = file.clone();
             damaged[flip] ^= 0x10;
-            assert_ne!(ENTRY.parse(&damaged, b"key"), Ok(Some(b"payload".to_vec())), "byte {flip}");
+            let sound = ENTRY.parse(&damaged, b"key") == Ok(Some(file.len() - 7)) && damaged.ends_with(b"payload");
+            assert!(!sound, "byte {flip}");
         }
         let mut longer = file.clone();
         longer.push(0);

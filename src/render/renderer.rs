@@ -485,9 +485,6 @@ impl Renderer {
 
 /// An environment with its sampling tables, on the GPU.
 fn upload_environment(ctx: &Context, environment: &Environment) -> Result<GpuEnvironment> {
-    let timing = crate::timings::phase(|| "environment tables".to_string());
-    let distribution = Distribution::for_device(environment, ctx.info().max_image_dimension_2d);
-    drop(timing);
-    let _timing = crate::timings::phase(|| "environment upload".to_string());
+    let distribution: Distribution = crate::environment::cache::distribution(environment, ctx.info().max_image_dimension_2d);
     GpuEnvironment::upload(ctx, environment, &distribution)
 }

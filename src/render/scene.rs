@@ -67,12 +67,8 @@ impl Scene {
         };
         prepare_look(&mut look, &spec.sets)?;
         let settings = Settings::resolve(&look, &spec.overrides)?;
-        let timing = crate::timings::phase(|| "environment decode".to_string());
         let environment = load_environment(settings.environment.as_ref(), &spec.env_options)?;
-        drop(timing);
-        let timing = crate::timings::phase(|| "g-buffer".to_string());
         let ReadGBuffer { gbuffer, name: gbuffer_name, claims } = read_gbuffer(&spec.gbuffer, &mut look, spec.quiet)?;
-        drop(timing);
         claims.into_iter().for_each(crate::warn);
         let covered = covered_object_ids(&gbuffer);
         let stacks = PackedStacks::pack(&look, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
