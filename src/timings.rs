@@ -31,17 +31,17 @@ pub struct Phase {
     started: Option<(String, Instant)>,
 }
 
-/// Starts timing a phase named `name` (called only when timings are on).
-pub fn phase(name: impl FnOnce() -> String) -> Phase {
+/// Starts timing a phase named `name` (formatted only when timings are on).
+pub fn phase(name: impl std::fmt::Display) -> Phase {
     if !enabled() {
         return Phase { started: None };
     }
     let now = Instant::now();
     ORIGIN.get_or_init(|| now);
-    Phase { started: Some((name(), now)) }
+    Phase { started: Some((name.to_string(), now)) }
 }
 
-/// Prints a line for something that was measured without a [`Phase`] (a count, a cache hit).
+/// Prints a line for an event rather than a span (what came from a cache).
 pub fn note(text: impl FnOnce() -> String) {
     if enabled() {
         eprintln!("lookdev: timing: {}", text());

@@ -148,11 +148,8 @@ fn damaged_cache_files_are_ignored_and_made_again() {
     let case = Case::new();
     case.render(Some(&case.cache()), "reference.exr", &[]);
     let reference = case.pixels("reference.exr");
-    let files = [
-        case.file("pipelines", ".bin"),
-        case.file("environments", ".tables"),
-        case.file("environments", ".texels"),
-    ];
+    let files =
+        [case.file("pipelines", ".bin"), case.file("environments", ".tables"), case.file("environments", ".texels")];
     type Damage = fn(&Path);
     let damages: [(&str, Damage); 5] = [
         ("truncated", |p| {

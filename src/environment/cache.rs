@@ -52,7 +52,7 @@ fn sources_hash() -> [u8; 16] {
 /// texels a side: [`Distribution::for_device`]'s, from the cache when it holds them, else built
 /// and stored.
 pub fn distribution(environment: &Environment, max_image_side: u32) -> Distribution {
-    let _timing = crate::timings::phase(|| "environment tables".to_string());
+    let _timing = crate::timings::phase("environment tables");
     let mut key = Vec::new();
     key.extend_from_slice(&cache::hash128(bytemuck::cast_slice(&environment.texels)));
     for value in [environment.width, environment.height, max_image_side, MAX_CELLS] {
@@ -63,7 +63,10 @@ pub fn distribution(environment: &Environment, max_image_side: u32) -> Distribut
     let cached = path.as_deref().and_then(|path| TABLES.load(path, &key)).and_then(|payload| {
         let decoded = decode_tables(&payload, environment.width, environment.height);
         if decoded.is_none() {
-            crate::warn(format!("ignoring the cache file {}: its tables do not fit the map; they are made again", path_text(&path)));
+            crate::warn(format!(
+                "ignoring the cache file {}: its tables do not fit the map; they are made again",
+                path_text(&path)
+            ));
         }
         decoded
     });
@@ -88,7 +91,7 @@ fn path_text(path: &Option<PathBuf>) -> String {
 /// cache when it holds it, else decoded by `decode` and stored. Cached texels are checked as a
 /// file's are.
 pub fn builtin(name: &str, content_hash: u64, decode: impl FnOnce() -> Environment) -> Environment {
-    let _timing = crate::timings::phase(|| "environment decode".to_string());
+    let _timing = crate::timings::phase("environment decode");
     let mut key = name.as_bytes().to_vec();
     key.extend_from_slice(&content_hash.to_le_bytes());
     key.extend_from_slice(&sources_hash());

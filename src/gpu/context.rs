@@ -214,7 +214,7 @@ impl Context {
     /// Each part is owned as soon as it is made (the instance, the surface, then the device in
     /// [`Shared`]), so a step that fails drops, and so destroys, the parts made before it.
     fn create(options: &ContextOptions, presentation: Option<Presentation>) -> Result<(Context, Option<Surface>)> {
-        let _timing = crate::timings::phase(|| "vulkan context".to_string());
+        let _timing = crate::timings::phase("vulkan context");
         let entry = unsafe { ash::Entry::load() }
             .map_err(|e| Error::gpu(format!("no Vulkan loader found ({e}); {INSTALL_DRIVER}")))?;
         let counter = Arc::new(ValidationCounter::default());

@@ -90,7 +90,7 @@ impl ComputePipeline {
         push_size: u32,
         constants: &[u32],
     ) -> Result<ComputePipeline> {
-        let _timing = crate::timings::phase(|| format!("pipeline {}", kernel.name));
+        let _timing = crate::timings::phase(format_args!("pipeline {}", kernel.name));
         let device = &ctx.shared.device;
         // From here on, Drop releases whatever has been created if a later step fails.
         let mut result = ComputePipeline {

@@ -70,8 +70,9 @@ impl PipelineCache {
     /// The context's cache, with the stored data when there is sound data for this device and
     /// build. Without a cache folder, or when the driver refuses the data, it starts empty.
     pub(crate) fn new(device: &ash::Device, props: &vk::PhysicalDeviceProperties) -> crate::Result<PipelineCache> {
-        let _timing = crate::timings::phase(|| "pipeline cache load".to_string());
-        let file = format!("{:04x}-{:04x}-{}.bin", props.vendor_id, props.device_id, cache::hex(&props.pipeline_cache_uuid));
+        let _timing = crate::timings::phase("pipeline cache load");
+        let file =
+            format!("{:04x}-{:04x}-{}.bin", props.vendor_id, props.device_id, cache::hex(&props.pipeline_cache_uuid));
         let path = cache::folder("pipelines").map(|folder| folder.join(file));
         let (key, header) = (key(props), expected_header(props));
         let data = path.as_deref().and_then(|path| ENTRY.load(path, &key)).filter(|data| header_matches(data, &header));
@@ -100,7 +101,7 @@ impl PipelineCache {
         if let (Some(path), Ok(data)) = (&self.path, unsafe { device.get_pipeline_cache_data(self.handle) }) {
             let changed = self.loaded != Some(cache::hash128(&data));
             if changed && header_matches(&data, &self.header) {
-                let _timing = crate::timings::phase(|| "pipeline cache save".to_string());
+                let _timing = crate::timings::phase("pipeline cache save");
                 ENTRY.store(path, &self.key, &data);
             }
         }

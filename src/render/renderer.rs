@@ -485,6 +485,7 @@ impl Renderer {
 
 /// An environment with its sampling tables, on the GPU.
 fn upload_environment(ctx: &Context, environment: &Environment) -> Result<GpuEnvironment> {
-    let distribution: Distribution = crate::environment::cache::distribution(environment, ctx.info().max_image_dimension_2d);
+    let distribution: Distribution =
+        crate::environment::cache::distribution(environment, ctx.info().max_image_dimension_2d);
     GpuEnvironment::upload(ctx, environment, &distribution)
 }
