@@ -176,18 +176,17 @@ impl Entry {
         out
     }
 
-    /// Writes the entry to `path` atomically, creating its folder. A failure (a read-only
+    /// Writes the entry to `path` atomically (unsynced: a file damaged by a crash is detected
+    /// and made again), creating its folder. A failure (a read-only
     /// folder, a full disk) leaves the cache without it and is otherwise ignored: it is shown
     /// only with `LOOKDEV_TIMINGS=1`.
     pub fn store(&self, path: &Path, key: &[u8], payload: &[u8]) {
         if payload.len() as u64 > self.max_payload {
             return;
         }
-        let written = path
-            .parent()
-            .map_or(Ok(()), std::fs::create_dir_all)
-            .map_err(|e| e.to_string())
-            .and_then(|()| crate::atomic_file::write(path, &self.encode(key, payload)).map_err(|e| e.to_string()));
+        let written = path.parent().map_or(Ok(()), std::fs::create_dir_all).map_err(|e| e.to_string()).and_then(|()| {
+            crate::atomic_file::write_unsynced(path, &self.encode(key, payload)).map_err(|e| e.to_string())
+        });
         match written {
             Ok(()) => crate::timings::note(|| format!("cache: wrote {}", path.display())),
             Err(e) => crate::timings::note(|| format!("cache: cannot write {} ({e})", path.display())),
