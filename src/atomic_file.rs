@@ -71,12 +71,25 @@ pub fn write_new(path: &Path, bytes: &[u8]) -> Result<()> {
 /// or by hard link (only if `path` does not exist). On any failure the temporary file is
 /// removed and `path` is untouched.
 pub fn write_with(path: &Path, replace: bool, fill: impl FnOnce(&mut File) -> std::io::Result<()>) -> Result<()> {
+    put(path, replace, true, fill)
+}
+
+/// Like [`write`], without waiting for the bytes to reach the disk: for files that can be made
+/// again (caches), whose readers detect a damaged file. Readers and other writers still never see
+/// a half-written file; only a crash of the whole system can leave one.
+pub fn write_unsynced(path: &Path, bytes: &[u8]) -> Result<()> {
+    put(path, true, false, |file| file.write_all(bytes))
+}
+
+fn put(path: &Path, replace: bool, sync: bool, fill: impl FnOnce(&mut File) -> std::io::Result<()>) -> Result<()> {
     remove_stale_temporaries(path);
     let temporary = temporary_path(path);
     let result = (|| {
         let mut file = File::create(&temporary)?;
         fill(&mut file)?;
-        file.sync_all()?;
+        if sync {
+            file.sync_all()?;
+        }
         drop(file);
         if replace {
             std::fs::rename(&temporary, path)

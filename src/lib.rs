@@ -7,6 +7,7 @@
 
 pub mod asset;
 pub mod atomic_file;
+pub mod cache;
 pub mod cli;
 pub mod config;
 pub mod environment;
@@ -19,6 +20,7 @@ pub mod material;
 pub mod render;
 pub mod shading;
 pub mod suggest;
+pub mod timings;
 #[cfg(feature = "viewer")]
 pub mod viewer;
 pub mod viewer_state;

@@ -64,15 +64,20 @@ struct Rendered {
 fn render(ctx: &Context, scene: &Scene, aovs: &[Aov], label: &str, quiet: bool) -> Result<Rendered> {
     scene.check_device(ctx.info())?;
     let settings = &scene.settings;
+    let timing = crate::timings::phase("renderer");
     let mut renderer = Renderer::with_model(ctx, &scene.gbuffer, &scene.environment, &settings.model)?;
     renderer.set_accumulate(aov::accumulate(aovs))?;
     renderer.set_stacks(&scene.stacks)?;
     renderer.set_lighting(settings.lighting);
     renderer.set_seed(settings.seed);
     renderer.set_sampling(settings.sampling, &scene.environment)?;
+    drop(timing);
+    let timing = crate::timings::phase("render");
     let mut progress = Progress::new(settings.spp as u64, label, quiet);
     let stats = progressive::accumulate(&mut renderer, settings.spp, |done| progress.update(done as u64))?;
     progress.finish();
+    drop(timing);
+    let _timing = crate::timings::phase("read back");
     let sources = aov::Sources { gbuffer: &scene.gbuffer, look: &scene.look, renderer: &renderer };
     Ok(Rendered {
         width: renderer.width,
@@ -95,7 +100,17 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if let Some(second) = &args.compare {
         return run_compare(&args, format, second.as_deref(), &spec);
     }
-    let scene = Scene::load(&spec)?;
+    // The device is opened while the scene loads: neither needs the other, and on a CPU driver
+    // both take a while. A bad scene is still reported first.
+    let (scene, ctx) = std::thread::scope(|threads| {
+        let opening = threads.spawn(|| super::context(args.device.clone()));
+        let scene = {
+            let _timing = crate::timings::phase("scene");
+            Scene::load(&spec)
+        };
+        (scene, opening.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
+    });
+    let scene = scene?;
     let settings = &scene.settings;
     // The AOVs the output writes: an EXR the ones asked for, a PNG the one it shows.
     let display = args.aov_display.as_deref().map(|name| display_aov(name, format)).transpose()?;
@@ -105,12 +120,13 @@ pub fn run(args: RenderArgs) -> Result<()> {
         (OutputFormat::Png, None) => Vec::new(),
     };
 
-    let ctx = super::context(args.device.clone())?;
+    let ctx = ctx?;
     let counter = ctx.validation_counter();
     let device_name = ctx.info().name.clone();
     let rendered = render(&ctx, &scene, &aovs, "rendering", args.quiet)?;
     drop(ctx);
     super::check_validation(&counter)?;
+    let _timing = crate::timings::phase("write");
     let metadata = Metadata::of_render(&scene.look, settings, &scene.environment);
     match display {
         Some(aov) => write_aov_png(&args.out, &rendered, aov, settings)?,

@@ -74,8 +74,12 @@ impl Builtin {
         content_hash(self.bytes)
     }
 
-    /// Decodes it.
+    /// Decodes it, or takes it from the cache of decoded built-ins.
     pub fn load(&self) -> Environment {
+        super::cache::builtin(self.name, self.content_hash(), || self.decode())
+    }
+
+    fn decode(&self) -> Environment {
         let name = format!("built-in {}", self.name);
         let (width, height, mut texels) =
             load::read_exr_texels(self.bytes, &name).expect("an embedded environment reads");

@@ -7,6 +7,7 @@
 //! lookups use `R_y(−r)·d`.
 
 pub mod builtin;
+pub mod cache;
 pub mod distribution;
 pub mod gpu;
 pub mod library;

@@ -1,6 +1,7 @@
 //! The Vulkan context: instance, the chosen device, one compute queue and its command pool.
 
 use super::inject::{self, Step};
+use super::pipeline_cache::PipelineCache;
 use crate::{Error, Result};
 use ash::vk;
 use std::ffi::{c_void, CStr, CString};
@@ -127,9 +128,18 @@ pub(crate) struct Shared {
     pub(crate) info: DeviceInfo,
     /// Null until made.
     command_pool: vk::CommandPool,
+    /// What every pipeline is made through; None until made.
+    pipeline_cache: Option<PipelineCache>,
     /// Serialises [`Context::run`]: the command pool and the queue must not be used from two
     /// threads at once.
     submission: std::sync::Mutex<()>,
+}
+
+impl Shared {
+    /// The cache every pipeline is made through (null only while the context is being made).
+    pub(crate) fn pipeline_cache(&self) -> vk::PipelineCache {
+        self.pipeline_cache.as_ref().map_or(vk::PipelineCache::null(), |cache| cache.handle)
+    }
 }
 
 impl Drop for Shared {
@@ -137,6 +147,9 @@ impl Drop for Shared {
         // Destroying a null handle does nothing, so a half-made context drops cleanly.
         unsafe {
             let _ = self.device.device_wait_idle();
+            if let Some(cache) = &mut self.pipeline_cache {
+                cache.save_and_destroy(&self.device);
+            }
             self.device.destroy_command_pool(self.command_pool, None);
             self.device.destroy_device(None);
         }
@@ -201,6 +214,7 @@ impl Context {
     /// Each part is owned as soon as it is made (the instance, the surface, then the device in
     /// [`Shared`]), so a step that fails drops, and so destroys, the parts made before it.
     fn create(options: &ContextOptions, presentation: Option<Presentation>) -> Result<(Context, Option<Surface>)> {
+        let _timing = crate::timings::phase("vulkan context");
         let entry = unsafe { ash::Entry::load() }
             .map_err(|e| Error::gpu(format!("no Vulkan loader found ({e}); {INSTALL_DRIVER}")))?;
         let counter = Arc::new(ValidationCounter::default());
@@ -436,6 +450,7 @@ fn create_device(instance: Arc<Instance>, options: &ContextOptions, surface: Opt
         memory_properties,
         info,
         command_pool: vk::CommandPool::null(),
+        pipeline_cache: None,
         submission: std::sync::Mutex::new(()),
     };
     let pool_info = vk::CommandPoolCreateInfo::default()
@@ -443,6 +458,8 @@ fn create_device(instance: Arc<Instance>, options: &ContextOptions, surface: Opt
         .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
     inject::check(Step::CommandPool)?;
     shared.command_pool = unsafe { shared.device.create_command_pool(&pool_info, None) }?;
+    let props = unsafe { shared.instance.get_physical_device_properties(physical_device) };
+    shared.pipeline_cache = Some(PipelineCache::new(&shared.device, &props)?);
     Ok(shared)
 }
 

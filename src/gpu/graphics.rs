@@ -155,7 +155,7 @@ impl GraphicsPipeline {
             .dynamic_state(&dynamic)
             .layout(result.layout)
             .push_next(&mut rendering);
-        let created = unsafe { device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) };
+        let created = unsafe { device.create_graphics_pipelines(ctx.shared.pipeline_cache(), &[info], None) };
         result.pipeline = created.map_err(|(_, e)| {
             Error::gpu(format!("pipeline {} + {}: creation failed ({e})", desc.vertex.file, desc.fragment.file))
         })?[0];

@@ -9,6 +9,7 @@ pub mod inject;
 pub mod interface;
 pub mod memory;
 pub mod pipeline;
+mod pipeline_cache;
 pub mod shaders;
 pub mod timer;
 

@@ -90,6 +90,7 @@ impl ComputePipeline {
         push_size: u32,
         constants: &[u32],
     ) -> Result<ComputePipeline> {
+        let _timing = crate::timings::phase(format_args!("pipeline {}", kernel.name));
         let device = &ctx.shared.device;
         // From here on, Drop releases whatever has been created if a later step fails.
         let mut result = ComputePipeline {
@@ -139,7 +140,7 @@ impl ComputePipeline {
         }
         let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(result.layout);
         inject::check(Step::Pipeline)?;
-        result.pipeline = unsafe { device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) }
+        result.pipeline = unsafe { device.create_compute_pipelines(ctx.shared.pipeline_cache(), &[info], None) }
             .map_err(|(_, e)| Error::gpu(format!("kernel {}: pipeline creation failed ({e})", kernel.name)))?[0];
         Ok(result)
     }

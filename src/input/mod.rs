@@ -39,6 +39,8 @@ pub enum Kind {
     Environment,
     /// A viewer snapshot's display image (PNG).
     SnapshotImage,
+    /// A file of lookdev's own cache (src/cache.rs), which checks each kind's tighter limit.
+    Cache,
 }
 
 impl Kind {
@@ -53,6 +55,7 @@ impl Kind {
             Kind::GBuffer => 4096 * MIB,
             Kind::Environment => 2048 * MIB,
             Kind::SnapshotImage => 1024 * MIB,
+            Kind::Cache => 512 * MIB,
         }
     }
 
@@ -65,6 +68,7 @@ impl Kind {
             Kind::GBuffer => "a g-buffer",
             Kind::Environment => "an environment",
             Kind::SnapshotImage => "a snapshot image",
+            Kind::Cache => "a cache file",
         }
     }
 }

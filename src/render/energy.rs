@@ -19,6 +19,7 @@ pub fn build(ctx: &Context, model: &Model) -> Result<EnergyTable> {
         INTERFACE.push_size(),
         &model.specialization(),
     )?;
+    let _timing = crate::timings::phase("energy table");
     let output = Buffer::storage(ctx, (SIZE * SIZE * 4) as u64)?;
     let set = pipeline.bind(0, &[Binding::Buffer(&output)])?;
     ctx.run(|cmd| {

@@ -45,13 +45,9 @@ impl Sampling {
     }
 
     /// The tables this estimator samples `env` by, on a device whose images are at most
-    /// `max_image_side` texels a side.
+    /// `max_image_side` texels a side (from the cache of tables when it holds them).
     pub fn distribution(self, env: &Environment, max_image_side: u32) -> Distribution {
-        if self.compensated() {
-            Distribution::compensated_for_device(env, max_image_side)
-        } else {
-            Distribution::for_device(env, max_image_side)
-        }
+        crate::environment::cache::distribution(env, max_image_side, self.compensated())
     }
 }
 
