@@ -20,12 +20,13 @@ pub struct RenderStats {
 
 /// Accumulates until the renderer holds `spp` samples per pixel, calling `progress(samples)`
 /// after each dispatch. The split into dispatches never changes the result: the kernel adds
-/// samples in index order whatever the split.
+/// samples in index order whatever the split. Under a noise threshold, `spp` is the most a
+/// pixel takes, and the render ends early once every pixel has stopped.
 pub fn accumulate(renderer: &mut Renderer, spp: u32, mut progress: impl FnMut(u32)) -> Result<RenderStats> {
     let start = Instant::now();
     let mut stats = RenderStats::default();
     let mut batch = 1u32;
-    while renderer.samples() < spp {
+    while renderer.samples() < spp && renderer.active_pixels() != Some(0) {
         let count = batch.min(spp - renderer.samples());
         let dispatch_start = Instant::now();
         let gpu = renderer.render_samples(count)?;

@@ -10,6 +10,38 @@ use crate::{Error, Result};
 /// Samples per pixel when neither the look nor a flag says.
 pub const DEFAULT_SPP: u32 = 256;
 
+/// The least `--min-spp` when none is given: enough samples that the variance estimate that
+/// decides a pixel's stop is itself not too noisy.
+pub const DEFAULT_MIN_SPP: u32 = 16;
+
+/// Adaptive sampling (docs/shading.md#adaptive-sampling): each pixel stops once the estimated
+/// relative error of its mean, tested after `min_samples` and every 8 samples after, is below
+/// `threshold`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NoiseThreshold {
+    /// The relative standard error of the mean luminance at which a pixel stops (0 < t < 1e3).
+    pub threshold: f32,
+    /// The samples every pixel takes before it may stop (at least 2).
+    pub min_samples: u32,
+}
+
+impl NoiseThreshold {
+    /// Checks the values, naming the options they come from.
+    pub fn new(threshold: f32, min_samples: u32) -> Result<NoiseThreshold> {
+        if !(threshold.is_finite() && threshold > 0.0 && threshold < 1e3) {
+            return Err(Error::input(format!(
+                "--noise-threshold {threshold}: must be a number above 0 and below 1000"
+            )));
+        }
+        if min_samples < 2 {
+            return Err(Error::input(format!(
+                "--min-spp {min_samples}: a pixel needs at least 2 samples to estimate its noise"
+            )));
+        }
+        Ok(NoiseThreshold { threshold, min_samples })
+    }
+}
+
 /// Values given on the command line; `None` leaves the look's value.
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
