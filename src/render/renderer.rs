@@ -693,6 +693,20 @@ impl Renderer {
     pub fn read_resolved(&self) -> Result<Vec<[f32; 4]>> {
         Ok(bytemuck::cast_slice(&self.targets.resolved.read(&self.ctx)?).to_vec())
     }
+
+    /// Uploads new layer stacks and resolves them, as [`Renderer::set_stacks`] does, but
+    /// restarts only the covered pixels whose resolved material changed, bit for bit
+    /// ([`Renderer::restart_pixels`]); every other pixel keeps its samples. Returns how many
+    /// changed: an edit of one object's stack restarts that object's pixels, one of a masked
+    /// layer those where its weight is not 0 (docs/commands.md#edit-local-re-convergence).
+    pub fn set_stacks_local(&mut self, packed: &PackedStacks) -> Result<usize> {
+        self.resolve.set_stacks(&self.ctx, &mut self.gbuffer, packed, &self.targets)?;
+        let (width, height) = (self.width, self.height);
+        self.timed(|renderer, cmd| renderer.resolve.record(cmd, width, height))?;
+        let changed = self.resolve.changed_pixels(width as usize * height as usize)?;
+        self.restart_pixels(&changed);
+        Ok(changed.len())
+    }
 }
 
 /// An environment with its sampling tables, on the GPU.
