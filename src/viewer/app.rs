@@ -647,6 +647,9 @@ impl Running {
                 placement += &format!("; split at image column {column} ({a} | {b})");
             }
             placement += &self.snapshot_report();
+            if let Some(region) = self.session.restarted_region() {
+                placement += &format!("; {}", super::ui::region_status(region));
+            }
             println!(
                 "lookdev: screenshot {} ({}x{} window, {} spp{placement})",
                 path.display(),

@@ -24,6 +24,8 @@ use std::time::{Duration, Instant};
 
 /// Environments kept loaded, so that undoing a switch does not read the file again.
 const KEPT_ENVIRONMENTS: usize = 3;
+/// Samples a dispatch adds to restarted pixels when a save catches them up.
+const CATCH_UP_SAMPLES: u32 = 16;
 
 /// What the renderer was last given.
 struct Shown {
@@ -254,6 +256,12 @@ impl Session {
         self.compare.as_ref().map_or(a, |b| a.min(b.renderer.samples()))
     }
 
+    /// While the pixels an edit restarted alone catch up with the rest (A's): how many they
+    /// are, their samples and the rest's.
+    pub fn restarted_region(&self) -> Option<(usize, u32, u32)> {
+        self.renderer.restarted_region()
+    }
+
     /// Where accumulation stops.
     pub fn target(&self) -> u32 {
         self.target_override.unwrap_or(self.document.settings().spp)
@@ -444,11 +452,20 @@ impl Session {
         self.apply_changes(false)
     }
 
-    /// [`Session::sync`]; with `everything`, as if every part had changed.
+    /// [`Session::sync`]; with `everything`, as if every part had changed. A change of the
+    /// materials alone restarts only the pixels whose resolved material it changed; any other
+    /// change restarts every pixel (docs/commands.md#edit-local-re-convergence).
     fn apply_changes(&mut self, everything: bool) -> Result<()> {
         let settings = self.document.settings().clone();
         let mut restarted = false;
+        let mut restarted_locally = false;
         let material_changed = everything || self.document.material_revision() != self.shown.material_revision;
+        // Whether anything but the materials changes every pixel's image.
+        let whole = everything
+            || settings.environment != self.shown.environment
+            || settings.lighting != self.shown.lighting
+            || settings.seed != self.shown.seed
+            || settings.model != self.shown.model;
         if material_changed {
             let packed = PackedStacks::pack(
                 self.document.look(),
@@ -457,14 +474,26 @@ impl Session {
                 &self.gbuffer_name,
             )?;
             if everything || packed != self.packed {
-                self.renderer.set_stacks(&packed)?;
+                // Locally only once a first pass has replaced the preview: until then, rows
+                // still shown from it would keep the old materials.
+                if !whole && self.progressive.first_pass.is_some() {
+                    self.renderer.set_stacks_local(&packed)?;
+                    restarted_locally = true;
+                } else {
+                    self.renderer.set_stacks(&packed)?;
+                    restarted = true;
+                }
                 if let Some(b) = self.compare.as_mut().filter(|b| matches!(b.subject, Subject::Model(_))) {
-                    b.renderer.set_stacks(&packed)?;
+                    if !whole && b.progressive.first_pass.is_some() {
+                        b.renderer.set_stacks_local(&packed)?;
+                        b.progressive.restart_local();
+                    } else {
+                        b.renderer.set_stacks(&packed)?;
+                        b.progressive.restart();
+                    }
                     b.packed = packed.clone();
-                    b.progressive.restart();
                 }
                 self.packed = packed;
-                restarted = true;
             }
             self.shown.material_revision = self.document.material_revision();
         }
@@ -498,6 +527,10 @@ impl Session {
         }
         if restarted {
             self.progressive.restart();
+        } else if restarted_locally {
+            self.progressive.restart_local();
+        }
+        if restarted || restarted_locally {
             self.changed_at = Instant::now();
             self.first_pass_after_change = None;
             self.denoised_at = None;
@@ -549,13 +582,17 @@ impl Session {
         Ok(())
     }
 
-    /// Brings every row to the same sample count (rows may be a band apart mid-pass), so that
-    /// what is saved is a whole number of passes, as `lookdev render` makes.
+    /// Brings every row to the same sample count (rows may be a band apart mid-pass, and
+    /// pixels an edit restarted may still be catching up), so that what is saved is a whole
+    /// number of passes, as `lookdev render` makes.
     fn complete_pass(&mut self) -> Result<()> {
         let settings = self.document.settings();
         let (exposure, tonemap) = (settings.exposure, settings.tonemap);
         while let Some((first, rows)) = self.renderer.lagging_rows() {
-            self.renderer.render_rows(first, rows, 1)?;
+            // Restarted pixels stop at their rows' counts, so may take several samples at once;
+            // lagging rows are one band's samples behind.
+            let count = if self.renderer.restarted_region().is_some() { CATCH_UP_SAMPLES } else { 1 };
+            self.renderer.render_rows(first, rows, count)?;
             self.renderer.finalize_rows(first, rows, exposure, tonemap)?;
         }
         Ok(())
