@@ -10,8 +10,8 @@ use lookdev::environment::Environment;
 use lookdev::gbuffer::GBuffer;
 use lookdev::material::stack::PackedStacks;
 use lookdev::material::{Look, Param, Value};
-use lookdev::shading::tonemap::Tonemap;
 use lookdev::render::{Lighting, Renderer};
+use lookdev::shading::tonemap::Tonemap;
 use std::path::Path;
 
 /// A sphere whose bottom layer is rough and grey, with a masked layer over its left half
@@ -78,7 +78,8 @@ fn the_resolve_finds_exactly_the_pixels_an_edit_changes() {
     let gbuffer = orthographic_sphere(48);
     let base = pack(&look(SPHERE), &gbuffer);
     let covered = gbuffer.coverage.iter().filter(|&&a| a > 0.0).count();
-    let left = (0..gbuffer.pixel_count()).filter(|&i| gbuffer.coverage[i] > 0.0 && gbuffer.masks["left"][i] > 0.0).count();
+    let left =
+        (0..gbuffer.pixel_count()).filter(|&i| gbuffer.coverage[i] > 0.0 && gbuffer.masks["left"][i] > 0.0).count();
     let edits = [
         ("no change", look(SPHERE), 0),
         ("the masked layer", with_set(SPHERE, 0, 1, Param::Roughness, 0.6), left),

@@ -31,6 +31,10 @@ pub struct BenchArgs {
     /// With --interactive: how many edits (turns of the light) are timed.
     #[arg(long, default_value_t = 12, value_name = "N")]
     pub edits: u32,
+    /// With --interactive: instead, the time from an edit of one object's stack until that
+    /// object is back at 16 spp (the rest keeping their samples), against a full restart's.
+    #[arg(long, requires = "interactive")]
+    pub local_edit: bool,
 }
 
 const SIZES: [(u32, u32); 2] = [(512, 512), (1920, 1080)];

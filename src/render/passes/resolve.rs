@@ -111,8 +111,11 @@ impl ResolvePass {
     pub fn changed_pixels(&self, pixels: usize) -> Result<Vec<u32>> {
         let changed = self.changed.as_ref().expect("set_stacks() runs before the resolve");
         let bytes = changed.read(&self.ctx)?;
-        let words: Vec<u32> =
-            bytes.chunks_exact(4).take(pixels.div_ceil(32)).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect();
+        let words: Vec<u32> = bytes
+            .chunks_exact(4)
+            .take(pixels.div_ceil(32))
+            .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
+            .collect();
         Ok(changed_indices(&words, pixels))
     }
 }
