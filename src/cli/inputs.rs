@@ -192,6 +192,9 @@ fn overrides(lighting: &LightingArgs, sampling: &SamplingArgs, display: &Display
         tonemap: display.tonemap,
         model: sampling.model.clone(),
         aovs: Vec::new(),
+        // `render` and `turntable` set these from their own flags.
+        noise_threshold: None,
+        min_spp: None,
     }
 }
 

@@ -16,6 +16,8 @@ pub struct RenderStats {
     /// Sum of the relight kernels' GPU time, when the device has timestamps.
     pub gpu_seconds: Option<f64>,
     pub dispatches: u32,
+    /// Under a noise threshold, the mean samples per covered pixel.
+    pub mean_spp: Option<f64>,
 }
 
 /// Accumulates until the renderer holds `spp` samples per pixel, calling `progress(samples)`
@@ -50,5 +52,9 @@ pub fn accumulate(renderer: &mut Renderer, spp: u32, mut progress: impl FnMut(u3
         }
     }
     stats.wall = start.elapsed();
+    if renderer.noise_threshold().is_some() && renderer.covered_pixels() > 0 {
+        let counts = renderer.read_sample_counts()?;
+        stats.mean_spp = Some(counts.iter().map(|&n| n as f64).sum::<f64>() / renderer.covered_pixels() as f64);
+    }
     Ok(stats)
 }

@@ -361,6 +361,9 @@ impl Renderer {
     /// counts. Returns the GPU time.
     pub fn render_rows(&mut self, first_row: u32, rows: u32, count: u32) -> Result<Option<f64>> {
         assert!(self.resolve.has_stacks(), "set_stacks() must run before rendering");
+        if count == 0 {
+            return Ok(Some(0.0));
+        }
         let end = first_row.saturating_add(rows).min(self.height);
         if self.restarted.as_ref().is_some_and(|r| (0..self.height).any(|y| r.lags(y, &self.row_samples))) {
             return self.render_restarted(first_row, end, count);
@@ -641,6 +644,17 @@ impl Renderer {
     fn read_sums(&self) -> Result<Vec<[f32; 4]>> {
         self.check_rendered()?;
         Ok(bytemuck::cast_slice(&self.targets.accumulation.read(&self.ctx)?).to_vec())
+    }
+
+    /// The samples each pixel has in the current accumulation (its accumulation's alpha), 0
+    /// where uncovered: under a noise threshold, where each pixel stopped.
+    pub fn read_sample_counts(&self) -> Result<Vec<u32>> {
+        let sums = self.read_sums()?;
+        Ok(sums
+            .iter()
+            .zip(&self.lists.covered_mask)
+            .map(|(sum, &covered)| if covered { sum[3] as u32 } else { 0 })
+            .collect())
     }
 
     /// Each lobe's mean share of the estimate per pixel ([`LOBES`] order), not yet weighted by

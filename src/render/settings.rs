@@ -57,6 +57,10 @@ pub struct Overrides {
     pub model: Vec<String>,
     /// `--aov NAME`: when given, these AOVs instead of the look's `[render] aovs`.
     pub aovs: Vec<String>,
+    /// `--noise-threshold X`: adaptive sampling, with `spp` the most a pixel takes.
+    pub noise_threshold: Option<f32>,
+    /// `--min-spp N`: the samples a pixel takes before it may stop ([`DEFAULT_MIN_SPP`]).
+    pub min_spp: Option<u32>,
 }
 
 /// Everything a render needs besides the g-buffer and the stacks.
@@ -73,6 +77,8 @@ pub struct Settings {
     pub model: Model,
     /// The AOVs to write beside the beauty.
     pub aovs: Vec<crate::render::aov::Aov>,
+    /// Adaptive sampling, when asked for: `spp` is then the most a pixel takes.
+    pub noise: Option<NoiseThreshold>,
 }
 
 impl Settings {
@@ -108,7 +114,22 @@ impl Settings {
         let aov_names =
             if overrides.aovs.is_empty() { render.aovs.clone().unwrap_or_default() } else { overrides.aovs.clone() };
         let aovs = crate::render::aov::Aov::parse_all(&aov_names).map_err(|e| Error::input(format!("--aov: {e}")))?;
+        let noise = match (overrides.noise_threshold, overrides.min_spp) {
+            (None, None) => None,
+            (None, Some(n)) => {
+                return Err(Error::input(format!("--min-spp {n}: only adaptive sampling (--noise-threshold) takes it")))
+            }
+            (Some(_), Some(min_spp)) if min_spp > spp => {
+                return Err(Error::input(format!(
+                    "--min-spp {min_spp}: above the most samples a pixel takes (--spp {spp})"
+                )));
+            }
+            (Some(threshold), Some(min_spp)) => Some(NoiseThreshold::new(threshold, min_spp)?),
+            // With fewer samples than that in all, the pixels take them all.
+            (Some(threshold), None) => Some(NoiseThreshold::new(threshold, DEFAULT_MIN_SPP.min(spp).max(2))?),
+        };
         Ok(Settings {
+            noise,
             aovs,
             model,
             environment: overrides.environment.clone().or_else(|| env.source.clone()),
