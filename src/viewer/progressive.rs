@@ -140,7 +140,8 @@ impl Progressive {
     /// takes one sample per band, so the preview is replaced soonest; later bands take a few.
     /// Returns whether anything was rendered.
     pub fn step(&mut self, renderer: &mut Renderer, target: u32, exposure: f32, tonemap: Tonemap) -> Result<bool> {
-        if renderer.samples() >= target {
+        // Under a noise threshold, accumulation also stops once every pixel has stopped.
+        if renderer.samples() >= target || renderer.active_pixels() == Some(0) {
             return Ok(false);
         }
         if let Some((_, theirs, _)) = renderer.restarted_region() {

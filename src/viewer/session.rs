@@ -13,6 +13,7 @@ use crate::gpu::{Context, Image};
 use crate::material::params::Params;
 use crate::material::stack::{layer_weights, LayerWeight, PackedStacks};
 use crate::render::output::{self, OutputFormat};
+use crate::render::renderer::NoiseThreshold;
 use crate::render::scene::covered_object_ids;
 use crate::render::{Lighting, Renderer};
 use crate::shading::model::Model;
@@ -36,6 +37,7 @@ struct Shown {
     exposure: f32,
     tonemap: Tonemap,
     model: Model,
+    noise: Option<NoiseThreshold>,
 }
 
 /// Everything known about one pixel, for the inspector.
@@ -168,6 +170,7 @@ impl Session {
         renderer.set_stacks(&packed)?;
         renderer.set_lighting(settings.lighting);
         renderer.set_seed(settings.seed);
+        renderer.set_noise_threshold(settings.noise)?;
         Ok(Session {
             ctx: ctx.clone(),
             progressive: Progressive::new(),
@@ -181,6 +184,7 @@ impl Session {
                 exposure: settings.exposure,
                 tonemap: settings.tonemap,
                 model: settings.model,
+                noise: settings.noise,
             },
             document,
             renderer,
@@ -265,6 +269,20 @@ impl Session {
     /// Where accumulation stops.
     pub fn target(&self) -> u32 {
         self.target_override.unwrap_or(self.document.settings().spp)
+    }
+
+    /// Whether accumulation has stopped: every pixel has the target's samples, or under a
+    /// noise threshold every pixel has stopped (on both sides of a split).
+    pub fn converged(&self) -> bool {
+        let target = self.target();
+        let done = |r: &Renderer| r.samples() >= target || r.active_pixels() == Some(0);
+        done(&self.renderer) && self.compare.as_ref().is_none_or(|b| done(&b.renderer))
+    }
+
+    /// Under a noise threshold (`--noise-threshold`), A's pixels still taking samples and the
+    /// threshold.
+    pub fn adaptive(&self) -> Option<(u64, NoiseThreshold)> {
+        self.renderer.active_pixels().zip(self.renderer.noise_threshold())
     }
 
     /// What the view shows: the display pixels, or with the display filter on, its pixels.
@@ -376,6 +394,7 @@ impl Session {
         renderer.set_stacks(&packed)?;
         renderer.set_lighting(self.shown.lighting);
         renderer.set_seed(self.shown.seed);
+        renderer.set_noise_threshold(self.shown.noise)?;
         // Its display image starts cleared and is not shown until its first pass has landed
         // (see `compare_ready`).
         let mut progressive = Progressive::new();
@@ -465,7 +484,8 @@ impl Session {
             || settings.environment != self.shown.environment
             || settings.lighting != self.shown.lighting
             || settings.seed != self.shown.seed
-            || settings.model != self.shown.model;
+            || settings.model != self.shown.model
+            || settings.noise != self.shown.noise;
         if material_changed {
             let packed = PackedStacks::pack(
                 self.document.look(),
@@ -523,6 +543,15 @@ impl Session {
         if everything || settings.model != self.shown.model {
             self.renderer.set_model(&settings.model)?;
             self.shown.model = settings.model;
+            restarted = true;
+        }
+        if everything || settings.noise != self.shown.noise {
+            self.renderer.set_noise_threshold(settings.noise)?;
+            if let Some(b) = &mut self.compare {
+                b.renderer.set_noise_threshold(settings.noise)?;
+                b.progressive.restart();
+            }
+            self.shown.noise = settings.noise;
             restarted = true;
         }
         if restarted {

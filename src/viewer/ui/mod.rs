@@ -322,8 +322,13 @@ impl Interface {
         let session = frame.session;
         ui.horizontal(|ui| {
             let (samples, target) = (session.samples(), session.target());
-            let state = if samples >= target { "done" } else { "rendering" };
+            let state = if session.converged() { "done" } else { "rendering" };
             ui.label(format!("{samples} / {target} spp ({state})"));
+            if let Some((active, noise)) = session.adaptive() {
+                ui.separator();
+                ui.label(format!("adaptive {}: {} px sampling", noise.threshold, grouped(active as usize)))
+                    .on_hover_text(ADAPTIVE_HINT);
+            }
             if let Some(region) = session.restarted_region() {
                 ui.separator();
                 ui.label(region_status(region)).on_hover_text(REGION_HINT);
@@ -367,16 +372,24 @@ impl Interface {
 /// What the status bar says while the pixels an edit restarted catch up with the rest:
 /// "re-converging 12 345 px: 5/64 spp".
 pub fn region_status((pixels, theirs, rest): (usize, u32, u32)) -> String {
-    let digits = pixels.to_string();
-    let mut grouped = String::new();
+    format!("re-converging {} px: {theirs}/{rest} spp", grouped(pixels))
+}
+
+/// A count with its digits in groups of three: "12 345".
+fn grouped(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
     for (i, c) in digits.chars().enumerate() {
         if i > 0 && (digits.len() - i) % 3 == 0 {
-            grouped.push(' ');
+            out.push(' ');
         }
-        grouped.push(c);
+        out.push(c);
     }
-    format!("re-converging {grouped} px: {theirs}/{rest} spp")
+    out
 }
+
+const ADAPTIVE_HINT: &str = "--noise-threshold: each pixel stops once the estimated relative error of its mean \
+     luminance is below the threshold; accumulation stops when every pixel has, or at the target spp";
 
 const REGION_HINT: &str = "The edit changed the material of these pixels only: they start again and catch up with \
      the rest, which keep their samples";
