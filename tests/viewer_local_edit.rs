@@ -136,3 +136,22 @@ fn grouped(n: usize) -> String {
     }
     out
 }
+
+/// An edit in the middle of a pass, rows a band of samples apart: the restarted pixels catch up
+/// with each row's own count, and the pass then goes on where it was, so that the image is still
+/// `lookdev render`'s at the target (it overshot the target in rows below the edit's band).
+#[test]
+fn an_edit_in_the_middle_of_a_pass_ends_as_a_fresh_render() {
+    let Some(case) = Case::new() else { return };
+    let output = view_slowly(
+        &case,
+        &format!(
+            "wait-spp 1\nselect default 0\nset roughness 0.85\nset roughness 0.6\n\
+             wait-spp {SPP}\nsave-image after.exr\nsave-look edited.toml\n"
+        ),
+    );
+    let spp = SPP.to_string();
+    let render = ["render", "--gbuffer", "g.exr", "--look", "edited.toml", "--spp", &spp, "--quiet", "--out", "r.exr"];
+    assert_success(&case.command(&render).output().unwrap());
+    assert!(exr_bits(&case, "after.exr") == exr_bits(&case, "r.exr"), "{}", common::viewer::stderr(&output));
+}

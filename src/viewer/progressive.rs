@@ -80,6 +80,10 @@ pub struct Progressive {
     /// Whether the restarted pixels have had their first sample: the sweep before it takes one
     /// sample a band, so they show their new material soonest.
     region_swept: bool,
+    /// Where the sweep over the restarted pixels' rows is. The pass's own `cursor` stays where
+    /// the edit found it: the rows from there on have one count and those above it one more
+    /// band's, which the restarted pixels catch up with.
+    region_cursor: u32,
 }
 
 impl Progressive {
@@ -95,6 +99,7 @@ impl Progressive {
             preview: None,
             region_row_seconds: 0.0,
             region_swept: false,
+            region_cursor: 0,
         }
     }
 
@@ -116,7 +121,7 @@ impl Progressive {
     /// Starts over after an edit that restarted some pixels only
     /// ([`Renderer::set_stacks_local`]): the rest keep their samples and the first pass's time.
     pub fn restart_local(&mut self) {
-        self.cursor = 0;
+        self.region_cursor = 0;
         self.region_row_seconds = 0.0;
         self.region_swept = false;
     }
@@ -201,25 +206,25 @@ impl Progressive {
     ) -> Result<bool> {
         let Some((first, rows)) = renderer.lagging_rows() else { return Ok(false) };
         let end = first + rows;
-        if !(first..end).contains(&self.cursor) {
-            if self.cursor >= end {
+        if !(first..end).contains(&self.region_cursor) {
+            if self.region_cursor >= end {
                 self.region_swept = true;
             }
-            self.cursor = first;
+            self.region_cursor = first;
         }
         let count = if self.region_swept { SAMPLES_PER_BAND.min(target.saturating_sub(theirs)).max(1) } else { 1 };
         let per_row = if self.region_row_seconds > 0.0 { self.region_row_seconds } else { self.row_seconds };
         let wanted =
             if per_row > 0.0 { (self.budget.as_secs_f64() / (per_row * count as f64)) as u32 } else { MIN_BAND_ROWS };
-        let band = wanted.max(MIN_BAND_ROWS).min(end - self.cursor);
+        let band = wanted.max(MIN_BAND_ROWS).min(end - self.region_cursor);
         let start = Instant::now();
-        renderer.render_rows(self.cursor, band, count)?;
-        renderer.finalize_rows(self.cursor, band, exposure, tonemap)?;
+        renderer.render_rows(self.region_cursor, band, count)?;
+        renderer.finalize_rows(self.region_cursor, band, exposure, tonemap)?;
         // Not counted in the samples per second, which are of whole rows.
         let measured = start.elapsed().as_secs_f64() / (band as f64 * count as f64);
         self.region_row_seconds =
             if self.region_row_seconds == 0.0 { measured } else { 0.7 * self.region_row_seconds + 0.3 * measured };
-        self.cursor += band;
+        self.region_cursor += band;
         Ok(true)
     }
 
