@@ -3,6 +3,7 @@
 
 mod bake;
 mod bench;
+mod bench_adaptive;
 mod bench_interactive;
 mod brdf;
 mod gbuffer;
