@@ -1,18 +1,24 @@
 #version 460
-// One progressive pass of image-based relighting over a band of rows: for each covered pixel and
+// One progressive pass of image-based relighting over a list of covered pixels: for each pixel and
 // each sample index, one environment sample and one BRDF sample, combined with the power heuristic
 // (docs/shading.md#sampling). The running float32 sum of the estimates is accumulated in sample order, so
 // any split into passes and bands gives the same bits. Coverage and the background are composited
-// by finalize.comp, so background pixels cost nothing after the first pass of an accumulation.
-// Every pixel of a band has the same number of samples so far; keeping that number (and so the
-// branches below) uniform across the dispatch matters on SIMD CPU drivers.
+// by finalize.comp; the background is written by a pass of its own, once per accumulation.
 //
-// With block > 1 (the viewer's preview after a change) each invocation stands for a block × block
-// block of pixels: it writes the background of all of them and relights only the block's top-left
-// pixel, with the same sample 0 a full pass gives it, which overwrites it identically later.
+// Invocations run over a compacted, row-major list of the covered pixels (a band of rows is a
+// range of it), so no lane idles on background. Every pixel of one dispatch has the same number
+// of samples so far; keeping that number (and so the branches below) uniform across the dispatch
+// matters on SIMD CPU drivers. Each pixel's own count is its accumulation's alpha.
+//
+// The preview (source PREVIEW) relights the top-left pixel of every block × block block with the
+// same sample 0 a full pass gives it, which overwrites it identically later.
+//
+// With a noise threshold, a pixel stops once its estimated relative error falls below it, tested
+// only at fixed sample counts (min_samples, then every CHECK_EVERY), so where it stops does not
+// depend on how the samples are split into dispatches (docs/shading.md#adaptive-sampling).
 #extension GL_GOOGLE_include_directive : require
 
-layout(local_size_x = 16, local_size_y = 16) in;
+layout(local_size_x = 64) in;
 
 // The energy-compensation table of the model (a placeholder when compensation is off).
 #define ENERGY_TABLE_SET 0
@@ -43,8 +49,17 @@ layout(set = 0, binding = 3, rgba32f) uniform writeonly image2D background;
 // With LOBE_AOVS, the running sums of each lobe's share: layers diffuse (with subsurface),
 // specular, clearcoat and sheen, all weighted as they enter the total.
 layout(set = 0, binding = 5, rgba32f) uniform image2DArray lobe_sums;
-// With VARIANCE_AOV, the running sum of each estimate's squared luminance (r).
+// With VARIANCE_AOV, the running sum of each estimate's squared luminance (r), and 1 in g once
+// the pixel has stopped under a noise threshold.
 layout(set = 0, binding = 6, rgba32f) uniform image2D moments;
+// The covered pixels, x | y << 16, row-major, read as a list: entry i is texel (i % width, i / width).
+layout(set = 0, binding = 7, r32ui) uniform readonly uimage2D covered;
+// The same for the pixels restarted alone (Renderer::restart_pixels).
+layout(set = 0, binding = 8, r32ui) uniform readonly uimage2D restarted;
+// Under a noise threshold, each row's pixels still active after a dispatch of the covered list.
+layout(set = 0, binding = 9, std430) buffer Active {
+    uint rows[];
+} still_active;
 
 const int LOBE_DIFFUSE = 0;
 const int LOBE_SPECULAR = 1;
@@ -52,17 +67,30 @@ const int LOBE_CLEARCOAT = 2;
 const int LOBE_SHEEN = 3;
 
 layout(push_constant) uniform Pass {
-    uint first_sample;     // samples the band's pixels have; 0 starts a new accumulation
+    uint first_sample;     // samples the dispatch's pixels have; 0 starts their accumulation
     uint sample_count;
     uint seed;
     uint show_background;
     float cos_rotation;
     float sin_rotation;
     float intensity;
-    uint first_row;        // the band this dispatch covers: rows first_row .. end_row - 1
-    uint end_row;
-    uint block;            // pixels per side of the block one invocation covers: 1 for a full pass
+    uint source;           // SOURCE_*: which pixel invocation i stands for
+    uint first;            // the invocations' range (list entries, blocks or pixels): first .. end - 1
+    uint end;
+    uint block;            // SOURCE_PREVIEW: pixels per side of a block
+    float noise_threshold; // > 0: stop each pixel once its relative error is below it
+    uint min_samples;      // ... but not before this many samples (at least 2)
 } pass;
+
+const uint SOURCE_COVERED = 0u;     // entries of the covered list
+const uint SOURCE_RESTARTED = 1u;   // entries of the restarted list
+const uint SOURCE_PREVIEW = 2u;     // the blocks' top-left pixels, row-major
+const uint SOURCE_BACKGROUND = 3u;  // every pixel, row-major: the background only
+// Samples between two stop tests after min_samples.
+const uint CHECK_EVERY = 8u;
+// Below this mean luminance the error is taken relative to it instead, as relative MSE adds
+// 0.01 to r²: dark pixels need no finer an absolute error, and black ones stop.
+const float BLACK = 0.1;
 
 // R_y(−rotation)·d: world to environment space.
 vec3 to_environment(vec3 d) {
@@ -146,62 +174,80 @@ vec3 estimate_lobes(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec
     return result * pass.intensity;
 }
 
-void main() {
-    int block = int(max(pass.block, 1u));
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.x, gl_GlobalInvocationID.y) * block + ivec2(0, pass.first_row);
-    ivec2 size = imageSize(accumulation);
-    if (pixel.x >= size.x || pixel.y >= int(pass.end_row)) {
-        return;
+ivec2 unpack_pixel(uint packed) {
+    return ivec2(int(packed & 0xffffu), int(packed >> 16));
+}
+
+// Entry `i` of a list stored row by row in an image `width` texels wide.
+ivec2 list_texel(uint i, int width) {
+    return ivec2(int(i % uint(width)), int(i / uint(width)));
+}
+
+// The environment behind `pixel`, where the surface does not cover it all.
+void write_background(ivec2 pixel) {
+    float coverage = imageLoad(surface, ivec3(pixel, 0)).w;
+    vec3 behind = vec3(0.0);
+    if (pass.show_background != 0u && coverage < 1.0) {
+        vec3 view = imageLoad(surface, ivec3(pixel, 1)).xyz;
+        behind = pass.intensity * env_background(env_direction_to_uv(to_environment(-view)));
+    }
+    imageStore(background, pixel, vec4(behind, 0.0));
+}
+
+// Whether the stop test runs after `n` samples.
+bool checkpoint(uint n) {
+    return n >= pass.min_samples && (n - pass.min_samples) % CHECK_EVERY == 0u;
+}
+
+// Whether the standard error of the mean luminance, from the sums of the estimates and of their
+// squared luminances (as Renderer::read_variance computes it), is below noise_threshold times
+// the mean. min_samples >= 2, so n > 1.
+bool converged(vec3 total, float squares, uint n) {
+    float sum = luminance(total);
+    float mean = sum / float(n);
+    float variance = max(squares - sum * mean, 0.0) / (float(n) * float(n - 1u));
+    return sqrt(variance) < pass.noise_threshold * max(mean, BLACK);
+}
+
+// Adds samples first_sample .. first_sample + sample_count - 1 to a covered pixel.
+void relight(ivec2 pixel, ivec2 size) {
+    bool adaptive = VARIANCE_AOV != 0u && pass.noise_threshold > 0.0;
+    bool restart = pass.first_sample == 0u;
+    vec4 moment = (VARIANCE_AOV == 0u || restart) ? vec4(0.0) : imageLoad(moments, pixel);
+    if (adaptive && moment.g != 0.0) {
+        return;  // stopped at an earlier test
     }
     vec4 normal_coverage = imageLoad(surface, ivec3(pixel, 0));
-    float coverage = normal_coverage.w;
     vec3 view = imageLoad(surface, ivec3(pixel, 1)).xyz;
-    if (pass.first_sample == 0u) {
-        // The same for every pass, so computed once per accumulation.
-        for (int dy = 0; dy < block; dy++) {
-            for (int dx = 0; dx < block; dx++) {
-                ivec2 q = pixel + ivec2(dx, dy);
-                if (q.x >= size.x || q.y >= int(pass.end_row)) {
-                    continue;
-                }
-                float q_coverage = imageLoad(surface, ivec3(q, 0)).w;
-                vec3 behind = vec3(0.0);
-                if (pass.show_background != 0u && q_coverage < 1.0) {
-                    vec3 q_view = imageLoad(surface, ivec3(q, 1)).xyz;
-                    behind = pass.intensity * env_background(env_direction_to_uv(to_environment(-q_view)));
-                }
-                imageStore(background, q, vec4(behind, 0.0));
-            }
-        }
-    }
-    if (coverage <= 0.0) {
-        return;
-    }
-
     vec3 n = normal_coverage.xyz;
     vec3 t = imageLoad(surface, ivec3(pixel, 2)).xyz;
     vec3 b = cross(n, t);
     vec3 v = vec3(dot(view, t), dot(view, b), dot(view, n));
-    vec4 sum = pass.first_sample == 0u ? vec4(0.0) : imageLoad(accumulation, pixel);
+    vec4 sum = restart ? vec4(0.0) : imageLoad(accumulation, pixel);
+    float squares = moment.r;
+    vec3 lobes[4];
+    for (int k = 0; k < 4; k++) {
+        lobes[k] = (LOBE_AOVS == 0u || restart) ? vec3(0.0) : imageLoad(lobe_sums, ivec3(pixel, k)).rgb;
+    }
     // Emission is the surface's own radiance: not scaled by the environment's intensity, and
     // seen even where the shading normal faces away. It is added with each sample, so that the
     // sum keeps its sample order.
     vec3 emission = imageLoad(resolved, ivec3(pixel, 4)).rgb;
     uint end_sample = pass.first_sample + pass.sample_count;
+    bool stopped = false;
     // Facing away from the eye (a shading normal can), the BRDF is zero: only emission.
     if (v.z <= 0.0) {
         for (uint i = pass.first_sample; i < end_sample; i++) {
             sum.rgb += emission;
-        }
-        if (LOBE_AOVS != 0u && pass.first_sample == 0u) {
-            for (int k = 0; k < 4; k++) {
-                imageStore(lobe_sums, ivec3(pixel, k), vec4(0.0));
+            if (VARIANCE_AOV != 0u) {
+                float y = luminance(emission);
+                squares += y * y;
             }
-        }
-        if (VARIANCE_AOV != 0u) {
-            float y = luminance(emission);
-            float squares = pass.first_sample == 0u ? 0.0 : imageLoad(moments, pixel).r;
-            imageStore(moments, pixel, vec4(squares + float(pass.sample_count) * y * y, 0.0, 0.0, 0.0));
+            if (adaptive && checkpoint(i + 1u) && converged(sum.rgb, squares, i + 1u)) {
+                end_sample = i + 1u;
+                stopped = true;
+                break;
+            }
         }
     } else {
         Material m = unpack_material(imageLoad(resolved, ivec3(pixel, 0)), imageLoad(resolved, ivec3(pixel, 1)),
@@ -215,39 +261,66 @@ void main() {
         uint pixel_seed = hash_combine(hash_u32(pass.seed), uint(pixel.y) * uint(size.x) + uint(pixel.x));
         uint env_seed = hash_combine(pixel_seed, 0x454e56u);
         uint brdf_seed = hash_combine(pixel_seed, 0x425244u);
-        if (LOBE_AOVS == 0u && VARIANCE_AOV == 0u) {
-            for (uint i = pass.first_sample; i < end_sample; i++) {
-                sum.rgb += emission + estimate(s, choice, view_terms, fx, fy, fn, sobol_owen_2d(i, env_seed),
-                                               sobol_owen_2d(i, brdf_seed));
-            }
-        } else {
-            vec3 lobes[4];
-            for (int k = 0; k < 4; k++) {
-                lobes[k] = (LOBE_AOVS == 0u || pass.first_sample == 0u) ? vec3(0.0)
-                                                                          : imageLoad(lobe_sums, ivec3(pixel, k)).rgb;
-            }
-            float squares = (VARIANCE_AOV == 0u || pass.first_sample == 0u) ? 0.0 : imageLoad(moments, pixel).r;
-            for (uint i = pass.first_sample; i < end_sample; i++) {
+        for (uint i = pass.first_sample; i < end_sample; i++) {
+            vec3 x;
+            if (LOBE_AOVS != 0u) {
                 vec3 shares[4];
-                vec3 x = emission + estimate_lobes(s, choice, view_terms, fx, fy, fn, sobol_owen_2d(i, env_seed),
-                                                   sobol_owen_2d(i, brdf_seed), shares);
-                sum.rgb += x;
+                x = emission + estimate_lobes(s, choice, view_terms, fx, fy, fn, sobol_owen_2d(i, env_seed),
+                                              sobol_owen_2d(i, brdf_seed), shares);
                 for (int k = 0; k < 4; k++) {
                     lobes[k] += shares[k];
                 }
+            } else {
+                x = emission + estimate(s, choice, view_terms, fx, fy, fn, sobol_owen_2d(i, env_seed),
+                                        sobol_owen_2d(i, brdf_seed));
+            }
+            sum.rgb += x;
+            if (VARIANCE_AOV != 0u) {
                 float y = luminance(x);
                 squares += y * y;
             }
-            if (LOBE_AOVS != 0u) {
-                for (int k = 0; k < 4; k++) {
-                    imageStore(lobe_sums, ivec3(pixel, k), vec4(lobes[k], 0.0));
-                }
-            }
-            if (VARIANCE_AOV != 0u) {
-                imageStore(moments, pixel, vec4(squares, 0.0, 0.0, 0.0));
+            if (adaptive && checkpoint(i + 1u) && converged(sum.rgb, squares, i + 1u)) {
+                end_sample = i + 1u;
+                stopped = true;
+                break;
             }
         }
     }
+    if (LOBE_AOVS != 0u) {
+        for (int k = 0; k < 4; k++) {
+            imageStore(lobe_sums, ivec3(pixel, k), vec4(lobes[k], 0.0));
+        }
+    }
+    if (VARIANCE_AOV != 0u) {
+        imageStore(moments, pixel, vec4(squares, stopped ? 1.0 : 0.0, 0.0, 0.0));
+    }
     sum.a = float(end_sample);
     imageStore(accumulation, pixel, sum);
+    if (adaptive && !stopped && pass.source == SOURCE_COVERED) {
+        atomicAdd(still_active.rows[pixel.y], 1u);
+    }
+}
+
+void main() {
+    uint i = pass.first + gl_GlobalInvocationID.x;
+    if (i >= pass.end) {
+        return;
+    }
+    ivec2 size = imageSize(accumulation);
+    ivec2 pixel;
+    if (pass.source == SOURCE_BACKGROUND) {
+        write_background(list_texel(i, size.x));
+        return;
+    } else if (pass.source == SOURCE_PREVIEW) {
+        int block = int(max(pass.block, 1u));
+        pixel = list_texel(i, (size.x + block - 1) / block) * block;
+        if (imageLoad(surface, ivec3(pixel, 0)).w <= 0.0) {
+            return;
+        }
+    } else if (pass.source == SOURCE_RESTARTED) {
+        pixel = unpack_pixel(imageLoad(restarted, list_texel(i, size.x)).r);
+    } else {
+        pixel = unpack_pixel(imageLoad(covered, list_texel(i, size.x)).r);
+    }
+    relight(pixel, size);
 }

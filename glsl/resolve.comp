@@ -3,7 +3,9 @@
 // A layer's value at a pixel is its own value times, for each parameter bound to a map, the
 // map's value there. The bottom layer fills, and each layer above blends in with
 // w = clamp(opacity·m, 0, 1), where m is its mask (or 1 − mask when inverted; 1 without a mask).
-// Runs once per edit, not per sample.
+// Runs once per edit, not per sample. Each covered pixel whose material comes out different,
+// bit for bit, from what `resolved` held is flagged in `changed`, so that an edit restarts only
+// the pixels it changed (docs/commands.md#edit-local-re-convergence).
 #extension GL_GOOGLE_include_directive : require
 
 layout(local_size_x = 16, local_size_y = 16) in;
@@ -35,7 +37,15 @@ layout(set = 0, binding = 3, std430) readonly buffer Layers {
     Layer layers[];
 };
 
-layout(set = 0, binding = 4, rgba32f) uniform writeonly image2DArray resolved;
+layout(set = 0, binding = 4, rgba32f) uniform image2DArray resolved;
+// Layer 0: N.xyz and coverage A (relight.comp's `surface`): uncovered pixels are never relit,
+// so a change there restarts nothing.
+layout(set = 0, binding = 5, rgba32f) uniform readonly image2DArray surface;
+// One bit per pixel, index y·width + x, cleared before the dispatch: set where a covered
+// pixel's material changed.
+layout(set = 0, binding = 6, std430) buffer Changed {
+    uint changed[];
+};
 
 float channel(ivec2 pixel, int layer) {
     return imageLoad(channels, ivec3(pixel, layer)).r;
@@ -74,7 +84,14 @@ void main() {
             p[k] = p[k] * (1.0 - w) + q[k] * w;
         }
     }
+    bool differs = false;
     for (int k = 0; k < 5; k++) {
+        uvec4 before = floatBitsToUint(imageLoad(resolved, ivec3(pixel, k)));
+        differs = differs || any(notEqual(before, floatBitsToUint(p[k])));
         imageStore(resolved, ivec3(pixel, k), p[k]);
+    }
+    if (differs && imageLoad(surface, ivec3(pixel, 0)).a > 0.0) {
+        uint index = uint(pixel.y * size.x + pixel.x);
+        atomicOr(changed[index >> 5], 1u << (index & 31u));
     }
 }

@@ -416,9 +416,9 @@ fn a_mismatched_interface_is_reported() {
     });
     assert!(problems.iter().any(|p| p.contains("first_sample")), "{problems:?}");
     // A binding of the wrong kind, and one too many.
-    let problems = with(resolve::INTERFACE, |i| i.sets = &[&[BindingKind::StorageBuffer; 6]]);
+    let problems = with(resolve::INTERFACE, |i| i.sets = &[&[BindingKind::StorageBuffer; 8]]);
     assert!(problems.iter().any(|p| p.contains("binding 0")), "{problems:?}");
-    assert!(problems.iter().any(|p| p.contains("binding 5 is bound by Rust")), "{problems:?}");
+    assert!(problems.iter().any(|p| p.contains("binding 7 is bound by Rust")), "{problems:?}");
     // A buffer struct with a different stride.
     let problems = with(resolve::INTERFACE, |i| {
         const SHORT_LAYER: GlslStruct = GlslStruct { size: 160, ..resolve::INTERFACE.structs[1] };

@@ -38,6 +38,18 @@ pub struct BenchArgs {
     pub convergence: bool,
     #[command(flatten)]
     pub convergence_args: super::bench_convergence::ConvergenceArgs,
+    /// Instead of throughput, adaptive sampling (--noise-threshold) against uniform sampling:
+    /// wall time, mean spp and relative MSE against a 2048-spp reference of another seed.
+    #[arg(long)]
+    pub adaptive: bool,
+    /// With --adaptive: this g-buffer (e.g. a baked asset, in the default material) instead of
+    /// the built-in shader ball at 256x256.
+    #[arg(long, value_name = "FILE.exr", requires = "adaptive")]
+    pub gbuffer: Option<std::path::PathBuf>,
+    /// With --interactive: instead, the time from an edit of one object's stack until that
+    /// object is back at 16 spp (the rest keeping their samples), against a full restart's.
+    #[arg(long, requires = "interactive")]
+    pub local_edit: bool,
 }
 
 const SIZES: [(u32, u32); 2] = [(512, 512), (1920, 1080)];
@@ -58,6 +70,9 @@ pub fn run(args: BenchArgs) -> Result<()> {
     }
     if args.convergence {
         return super::bench_convergence::run(&args);
+    }
+    if args.adaptive {
+        return super::bench_adaptive::run(&args);
     }
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
@@ -88,6 +103,8 @@ pub fn run(args: BenchArgs) -> Result<()> {
         "(GPU, median)",
         format!("({} spp)", args.spp)
     );
+    // Per size: covered samples per second over the wall time, and per kernel time at 1 spp.
+    let mut rates: Vec<(f64, Option<f64>)> = Vec::new();
     for (width, height) in SIZES {
         let scene = builtin_scene(width, height)?;
         let gbuffer = &scene.gbuffer;
@@ -106,7 +123,8 @@ pub fn run(args: BenchArgs) -> Result<()> {
             }
         }
         kernel.sort_by(f64::total_cmp);
-        let kernel_ms = kernel.get(kernel.len() / 2).map(|t| format!("{:.2} ms", t * 1e3)).unwrap_or("n/a".into());
+        let median = kernel.get(kernel.len() / 2).copied();
+        let kernel_ms = median.map(|t| format!("{:.2} ms", t * 1e3)).unwrap_or("n/a".into());
 
         // Wall time to the target from a fresh accumulation, as `lookdev render` does it.
         renderer.restart();
@@ -122,6 +140,19 @@ pub fn run(args: BenchArgs) -> Result<()> {
             kernel_ms,
             wall
         );
+        let covered = gbuffer.pixel_count() as f64 * coverage;
+        rates.push((samples * coverage / wall, median.map(|t| covered / t)));
+    }
+    // How far partly covered frames fall behind: the covered rate of the last size against
+    // the first's, by wall time (batches as `render` makes them) and by kernel time at 1 spp.
+    if let [(first_wall, first_kernel), .., (last_wall, last_kernel)] = rates[..] {
+        let (w, h) = SIZES[SIZES.len() - 1];
+        let (w0, h0) = SIZES[0];
+        let kernel = match (first_kernel, last_kernel) {
+            (Some(a), Some(b)) => format!(", {:.0}% by kernel time", 100.0 * b / a),
+            _ => String::new(),
+        };
+        println!("covered rate at {w}x{h}: {:.0}% of {w0}x{h0}'s by wall time{kernel}", 100.0 * last_wall / first_wall);
     }
     drop(ctx);
     super::check_validation(&counter)

@@ -197,6 +197,9 @@ fn overrides(lighting: &LightingArgs, sampling: &SamplingArgs, display: &Display
         model: sampling.model.clone(),
         aovs: Vec::new(),
         sampling: sampling.sampling,
+        // `render` and `turntable` set these from their own flags.
+        noise_threshold: None,
+        min_spp: None,
     }
 }
 

@@ -4,6 +4,7 @@
 mod bake;
 mod bench;
 mod bench_convergence;
+mod bench_adaptive;
 mod bench_interactive;
 mod brdf;
 mod gbuffer;

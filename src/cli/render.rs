@@ -45,6 +45,28 @@ pub struct RenderArgs {
     /// PNG output: show this AOV instead of the beauty.
     #[arg(long, value_name = "NAME")]
     pub aov_display: Option<String>,
+    #[command(flatten)]
+    pub adaptive: AdaptiveArgs,
+}
+
+/// Adaptive sampling (docs/shading.md#adaptive-sampling), for `render` and `turntable`.
+#[derive(Args, Debug, Default)]
+pub struct AdaptiveArgs {
+    /// Adaptive sampling: each pixel stops once the estimated relative error of its mean
+    /// luminance is below X (e.g. 0.02); --spp is then the most a pixel takes.
+    #[arg(long, value_name = "X")]
+    pub noise_threshold: Option<f32>,
+    /// With --noise-threshold: the samples every pixel takes before it may stop (default 16).
+    #[arg(long, value_name = "N")]
+    pub min_spp: Option<u32>,
+}
+
+impl AdaptiveArgs {
+    /// Sets these options in `overrides`.
+    pub fn apply(&self, overrides: &mut Overrides) {
+        overrides.noise_threshold = self.noise_threshold;
+        overrides.min_spp = self.min_spp;
+    }
 }
 
 /// One render, read back for output.
@@ -73,6 +95,7 @@ fn render(ctx: &Context, scene: &Scene, aovs: &[Aov], label: &str, quiet: bool) 
     renderer.set_sampling(settings.sampling, &scene.environment)?;
     drop(timing);
     let timing = crate::timings::phase("render");
+    renderer.set_noise_threshold(settings.noise)?;
     let mut progress = Progress::new(settings.spp as u64, label, quiet);
     let stats = progressive::accumulate(&mut renderer, settings.spp, |done| progress.update(done as u64))?;
     progress.finish();
@@ -96,7 +119,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
             return Err(Error::input_file(&args.out, "the output folder does not exist"));
         }
     }
-    let spec = args.scene.spec(args.look.as_deref(), &args.aovs, args.quiet)?;
+    let mut spec = args.scene.spec(args.look.as_deref(), &args.aovs, args.quiet)?;
+    args.adaptive.apply(&mut spec.overrides);
     if let Some(second) = &args.compare {
         return run_compare(&args, format, second.as_deref(), &spec);
     }
@@ -133,12 +157,15 @@ pub fn run(args: RenderArgs) -> Result<()> {
         None => write(&args.out, format, &rendered, settings.lighting.background, &metadata)?,
     }
     if !args.quiet {
+        let spp = match rendered.stats.mean_spp {
+            Some(mean) => format!("{mean:.1} spp on average, at most {}", settings.spp),
+            None => format!("{} spp", settings.spp),
+        };
         eprintln!(
-            "lookdev: wrote {} ({}x{}, {} spp, {:.2} s on {device_name})",
+            "lookdev: wrote {} ({}x{}, {spp}, {:.2} s on {device_name})",
             args.out.display(),
             scene.gbuffer.width,
             scene.gbuffer.height,
-            settings.spp,
             rendered.stats.wall.as_secs_f64()
         );
     }

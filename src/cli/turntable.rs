@@ -36,6 +36,8 @@ pub struct TurntableArgs {
     /// Output path with a frame-number pattern, e.g. out/turn_%04d.png (or .exr).
     #[arg(long, value_name = "DIR/NAME_%04d.png")]
     pub out: String,
+    #[command(flatten)]
+    pub adaptive: super::render::AdaptiveArgs,
 }
 
 /// A printf-style frame pattern: the text around one `%d` or `%0Nd`.
@@ -90,7 +92,9 @@ pub fn run(args: TurntableArgs) -> Result<()> {
     if let Some(dir) = pattern.path(1).parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, format!("cannot create the output folder: {e}")))?;
     }
-    let scene = Scene::load(&args.scene.spec(args.look.as_deref(), &args.aovs, args.quiet)?)?;
+    let mut spec = args.scene.spec(args.look.as_deref(), &args.aovs, args.quiet)?;
+    args.adaptive.apply(&mut spec.overrides);
+    let scene = Scene::load(&spec)?;
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
     scene.check_device(ctx.info())?;

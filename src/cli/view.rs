@@ -40,6 +40,10 @@ pub struct ViewArgs {
     /// Open with an A/B split: B is this look (its stacks and model, A's lighting and settings).
     #[arg(long, value_name = "B.toml")]
     pub compare_look: Option<PathBuf>,
+    /// Adaptive sampling as the accumulation's target: it stops once every pixel's estimated
+    /// relative error is below --noise-threshold (or at the target spp).
+    #[command(flatten)]
+    pub adaptive: super::render::AdaptiveArgs,
 }
 
 pub fn run(args: ViewArgs) -> Result<()> {
@@ -67,7 +71,8 @@ pub fn run(args: ViewArgs) -> Result<()> {
     for key in &args.compare_model {
         model.set_from_flag("--compare-model", key).map_err(Error::input)?;
     }
-    let scene = args.scene.spec(args.look.as_deref(), &[], false)?;
+    let mut scene = args.scene.spec(args.look.as_deref(), &[], false)?;
+    args.adaptive.apply(&mut scene.overrides);
     open(args, scene, window_size)
 }
 

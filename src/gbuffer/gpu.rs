@@ -74,4 +74,10 @@ impl GpuGBuffer {
         }
         Ok(&self.channel_layers.as_ref().expect("just made").1)
     }
+
+    /// [`Self::channel_layers`] with the surface image beside it, for a pass that binds both.
+    pub fn surface_and_channel_layers(&mut self, ctx: &Context, packed: &PackedStacks) -> Result<(&Image, &Image)> {
+        self.channel_layers(ctx, packed)?;
+        Ok((&self.surface, &self.channel_layers.as_ref().expect("just made").1))
+    }
 }

@@ -50,6 +50,7 @@ impl<'a> Batch<'a> {
         self.renderer.set_lighting(settings.lighting);
         self.renderer.set_seed(settings.seed);
         self.renderer.set_sampling(settings.sampling, self.environment)?;
+        self.renderer.set_noise_threshold(settings.noise)?;
         progressive::accumulate(&mut self.renderer, settings.spp, progress)?;
         Ok(())
     }

@@ -16,16 +16,19 @@ pub struct RenderStats {
     /// Sum of the relight kernels' GPU time, when the device has timestamps.
     pub gpu_seconds: Option<f64>,
     pub dispatches: u32,
+    /// Under a noise threshold, the mean samples per covered pixel.
+    pub mean_spp: Option<f64>,
 }
 
 /// Accumulates until the renderer holds `spp` samples per pixel, calling `progress(samples)`
 /// after each dispatch. The split into dispatches never changes the result: the kernel adds
-/// samples in index order whatever the split.
+/// samples in index order whatever the split. Under a noise threshold, `spp` is the most a
+/// pixel takes, and the render ends early once every pixel has stopped.
 pub fn accumulate(renderer: &mut Renderer, spp: u32, mut progress: impl FnMut(u32)) -> Result<RenderStats> {
     let start = Instant::now();
     let mut stats = RenderStats::default();
     let mut batch = 1u32;
-    while renderer.samples() < spp {
+    while renderer.samples() < spp && renderer.active_pixels() != Some(0) {
         let count = batch.min(spp - renderer.samples());
         let dispatch_start = Instant::now();
         let gpu = renderer.render_samples(count)?;
@@ -49,5 +52,9 @@ pub fn accumulate(renderer: &mut Renderer, spp: u32, mut progress: impl FnMut(u3
         }
     }
     stats.wall = start.elapsed();
+    if renderer.noise_threshold().is_some() && renderer.covered_pixels() > 0 {
+        let counts = renderer.read_sample_counts()?;
+        stats.mean_spp = Some(counts.iter().map(|&n| n as f64).sum::<f64>() / renderer.covered_pixels() as f64);
+    }
     Ok(stats)
 }

@@ -3,7 +3,8 @@
 
 use super::passes::denoise::DenoisePass;
 use super::passes::finalize::{FinalizePass, FinalizePush};
-use super::passes::relight::RelightPass;
+use super::passes::pixel_lists::{PixelLists, RowList};
+use super::passes::relight::{RelightPass, Source};
 use super::passes::resolve::ResolvePass;
 use super::passes::Targets;
 use crate::environment::{Environment, GpuEnvironment};
@@ -20,6 +21,7 @@ use ash::vk;
 
 pub use super::passes::relight::{Accumulate, RelightPush, LOBES};
 pub use super::passes::RESOLVED_LAYERS;
+pub use super::settings::NoiseThreshold;
 
 /// The largest preview block: one relit pixel per 8 × 8.
 pub const MAX_PREVIEW_BLOCK: u32 = 8;
@@ -55,8 +57,21 @@ pub struct Renderer {
     timer: Option<GpuTimer>,
     lighting: Lighting,
     seed: u32,
-    /// Samples each row has in the current accumulation.
+    /// Samples each row's pixels have in the current accumulation (but the restarted ones').
     row_samples: Vec<u32>,
+    /// The covered pixels and the restarted ones, as lists the relight pass runs over.
+    lists: PixelLists,
+    /// Pixels restarted alone and still catching up with their rows.
+    restarted: Option<Restarted>,
+    /// Rows whose background image is that of the current lighting.
+    background_rows: Vec<bool>,
+    /// Adaptive sampling, when on.
+    noise: Option<NoiseThreshold>,
+    /// What was asked for with [`Renderer::set_accumulate`]; adaptive sampling adds the variance.
+    wanted_accumulate: Accumulate,
+    /// Under a noise threshold, each row's pixels still active: counted by the row's last pass,
+    /// all its covered pixels before one (and its restarted ones added when they restart).
+    row_active: Vec<u32>,
     /// Whether every row has had a pass since this renderer was made: until then, its display
     /// image holds rows it has not drawn (cleared when made, but not a picture of anything).
     passed: bool,
@@ -83,7 +98,8 @@ impl Renderer {
         let targets = Targets::new(ctx, width, height, accumulate)?;
         let gpu_environment = upload_environment(ctx, environment, Sampling::default())?;
         let resolve = ResolvePass::new(ctx)?;
-        let relight = RelightPass::new(ctx, model, accumulate, &gpu_gbuffer, &targets, &gpu_environment)?;
+        let lists = PixelLists::new(ctx, gbuffer)?;
+        let relight = RelightPass::new(ctx, model, accumulate, &gpu_gbuffer, &targets, &lists, &gpu_environment)?;
         let finalize = FinalizePass::new(ctx, &gpu_gbuffer, &targets)?;
         Ok(Renderer {
             ctx: ctx.clone(),
@@ -99,6 +115,12 @@ impl Renderer {
             lighting: Lighting::default(),
             seed: 0,
             row_samples: vec![0; height as usize],
+            row_active: (0..height).map(|y| lists.covered.row_len(y)).collect(),
+            lists,
+            restarted: None,
+            background_rows: vec![false; height as usize],
+            noise: None,
+            wanted_accumulate: accumulate,
             passed: false,
             preview: None,
             denoise: None,
@@ -111,6 +133,7 @@ impl Renderer {
         let gpu_environment = upload_environment(&self.ctx, environment, self.sampling)?;
         self.relight.set_environment(&gpu_environment)?;
         self.environment = gpu_environment;
+        self.background_rows.fill(false);
         self.restart();
         Ok(())
     }
@@ -132,6 +155,15 @@ impl Renderer {
     /// What the relight kernel accumulates beside the total (for the AOVs that need it), with
     /// its images; accumulation restarts. Nothing happens when it is the same.
     pub fn set_accumulate(&mut self, accumulate: Accumulate) -> Result<()> {
+        self.wanted_accumulate = accumulate;
+        self.apply_accumulate()
+    }
+
+    /// Makes the relight kernel accumulate what was asked for, and the variance adaptive
+    /// sampling needs; accumulation restarts if that changes.
+    fn apply_accumulate(&mut self) -> Result<()> {
+        let accumulate =
+            Accumulate { variance: self.wanted_accumulate.variance || self.noise.is_some(), ..self.wanted_accumulate };
         if accumulate == self.relight.accumulate {
             return Ok(());
         }
@@ -139,22 +171,30 @@ impl Renderer {
         self.respecialize(self.relight.shading.model, accumulate)
     }
 
-    /// What the relight kernel accumulates beside the total.
+    /// What the relight kernel accumulates beside the total, as asked for.
     pub fn accumulate(&self) -> Accumulate {
-        self.relight.accumulate
+        self.wanted_accumulate
     }
 
     /// A new relight pass for this model and accumulation.
     fn respecialize(&mut self, model: Model, accumulate: Accumulate) -> Result<()> {
-        self.relight =
-            RelightPass::new(&self.ctx, &model, accumulate, &self.gbuffer, &self.targets, &self.environment)?;
+        self.relight = RelightPass::new(
+            &self.ctx,
+            &model,
+            accumulate,
+            &self.gbuffer,
+            &self.targets,
+            &self.lists,
+            &self.environment,
+        )?;
         self.restart();
         Ok(())
     }
 
-    /// Samples every pixel has accumulated since the last change.
+    /// Samples every pixel has accumulated since the last change: the least of any row's
+    /// (under a noise threshold, stopped pixels keep fewer).
     pub fn samples(&self) -> u32 {
-        self.row_samples.iter().copied().min().unwrap_or(0)
+        (0..self.height).map(|row| self.row_samples(row)).min().unwrap_or(0)
     }
 
     /// Whether every row has been rendered at least once since the renderer was made (restarts
@@ -163,14 +203,27 @@ impl Renderer {
         self.passed
     }
 
-    /// Samples row `row` has in the current accumulation.
+    /// Samples row `row` has in the current accumulation: the least of its pixels', those
+    /// restarted alone included.
     pub fn row_samples(&self, row: u32) -> u32 {
-        self.row_samples[row as usize]
+        let samples = self.row_samples[row as usize];
+        match &self.restarted {
+            Some(r) if r.list.row_len(row) > 0 => samples.min(r.samples[row as usize]),
+            _ => samples,
+        }
     }
 
     /// The first run of rows with fewer samples than the most-sampled row, as (first row, rows):
-    /// what a band-by-band pass still has to do before every row has the same count.
+    /// what a band-by-band pass still has to do before every row has the same count. While
+    /// restarted pixels catch up, the rows from the first to the last that holds them.
     pub fn lagging_rows(&self) -> Option<(u32, u32)> {
+        if let Some(r) = &self.restarted {
+            let lagging = |&y: &u32| r.lags(y, &self.row_samples);
+            if let Some(first) = (0..self.height).find(lagging) {
+                let last = (0..self.height).rev().find(lagging).expect("found from the front");
+                return Some((first, last - first + 1));
+            }
+        }
         let most = *self.row_samples.iter().max()?;
         let first = self.row_samples.iter().position(|&n| n < most)?;
         let rows = self.row_samples[first..].iter().take_while(|&&n| n < most).count();
@@ -181,6 +234,7 @@ impl Renderer {
     pub fn set_lighting(&mut self, lighting: Lighting) {
         if lighting != self.lighting {
             self.lighting = lighting;
+            self.background_rows.fill(false);
             self.restart();
         }
     }
@@ -188,7 +242,78 @@ impl Renderer {
     /// Starts a new accumulation with everything unchanged.
     pub fn restart(&mut self) {
         self.row_samples.fill(0);
+        self.restarted = None;
+        for (y, active) in self.row_active.iter_mut().enumerate() {
+            *active = self.lists.covered.row_len(y as u32);
+        }
         self.preview = None;
+    }
+
+    /// Restarts the accumulation of `pixels` only (indices `y * width + x`, ascending): every
+    /// other pixel keeps its samples, bit for bit. The next passes relight the restarted pixels
+    /// alone, from sample 0, until they have their rows' counts ([`Renderer::render_rows`]);
+    /// then all go on together, and the image is what a fresh render at that count makes. Until
+    /// their first pass they show their old sums. Pixels restarted earlier that have not caught
+    /// up yet restart again with these; uncovered pixels have no samples and are left out.
+    pub fn restart_pixels(&mut self, pixels: &[u32]) {
+        let size = self.width * self.height;
+        let mut chosen: Vec<u32> = pixels.iter().copied().filter(|&p| p < size).collect();
+        if let Some(r) = &self.restarted {
+            let width = self.width;
+            chosen.extend(r.list.pixels.iter().map(|&p| (p >> 16) * width + (p & 0xffff)));
+        }
+        chosen.sort_unstable();
+        chosen.dedup();
+        // Rows with no samples start over anyway.
+        chosen.retain(|&p| self.lists.covered_mask[p as usize] && self.row_samples[(p / self.width) as usize] > 0);
+        if chosen.is_empty() {
+            self.restarted = None;
+            return;
+        }
+        let list = RowList::from_indices(self.width, self.height, chosen);
+        for (y, active) in self.row_active.iter_mut().enumerate() {
+            *active = (*active + list.row_len(y as u32)).min(self.lists.covered.row_len(y as u32));
+        }
+        self.restarted = Some(Restarted { samples: vec![0; self.height as usize], list, uploaded: false });
+    }
+
+    /// While pixels restarted alone ([`Renderer::restart_pixels`]) catch up: how many they
+    /// are, the samples they have (the least), and the samples the rest have (the least).
+    pub fn restarted_region(&self) -> Option<(usize, u32, u32)> {
+        let r = self.restarted.as_ref()?;
+        let theirs = (0..self.height).filter(|&y| r.list.row_len(y) > 0).map(|y| r.samples[y as usize]).min()?;
+        let rest = self.row_samples.iter().copied().min().unwrap_or(0);
+        Some((r.list.pixels.len(), theirs, rest))
+    }
+
+    /// Turns adaptive sampling on or off (docs/shading.md#adaptive-sampling); accumulation
+    /// restarts if that changes anything.
+    pub fn set_noise_threshold(&mut self, noise: Option<NoiseThreshold>) -> Result<()> {
+        if noise == self.noise {
+            return Ok(());
+        }
+        if let Some(n) = noise {
+            NoiseThreshold::new(n.threshold, n.min_samples)?;
+        }
+        self.noise = noise;
+        self.restart();
+        self.apply_accumulate()
+    }
+
+    /// The adaptive sampling in effect, if any.
+    pub fn noise_threshold(&self) -> Option<NoiseThreshold> {
+        self.noise
+    }
+
+    /// Under a noise threshold, the covered pixels still taking samples: as each row's last
+    /// pass left them (all of a row's before its first pass). None without a threshold.
+    pub fn active_pixels(&self) -> Option<u64> {
+        self.noise.map(|_| self.row_active.iter().map(|&n| n as u64).sum())
+    }
+
+    /// The covered pixels: every pixel the relight pass samples.
+    pub fn covered_pixels(&self) -> usize {
+        self.lists.covered.pixels.len()
     }
 
     pub fn set_seed(&mut self, seed: u32) {
@@ -235,22 +360,88 @@ impl Renderer {
     /// Accumulates `count` more samples for the pixels of rows `first_row..first_row + rows`
     /// only: how the viewer bounds the work of one frame. Rows keep their own counts, so bands may
     /// differ by a pass; [`Renderer::samples`] counts what every row has. Rows with different
-    /// counts take a dispatch each (usually there is one). Returns the GPU time.
+    /// counts take a dispatch each (usually there is one). While pixels restarted alone
+    /// ([`Renderer::restart_pixels`]) lag, only they are relit, and no further than their rows'
+    /// counts. Returns the GPU time.
     pub fn render_rows(&mut self, first_row: u32, rows: u32, count: u32) -> Result<Option<f64>> {
         assert!(self.resolve.has_stacks(), "set_stacks() must run before rendering");
+        if count == 0 {
+            return Ok(Some(0.0));
+        }
         let end = first_row.saturating_add(rows).min(self.height);
+        if self.restarted.as_ref().is_some_and(|r| (0..self.height).any(|y| r.lags(y, &self.row_samples))) {
+            return self.render_restarted(first_row, end, count);
+        }
+        self.restarted = None;
         let mut total = Some(0.0);
         let mut start = first_row;
         while start < end {
             let first_sample = self.row_samples[start as usize];
             let run_end = (start..end).find(|&r| self.row_samples[r as usize] != first_sample).unwrap_or(end);
-            let time = self.dispatch_relight(start, run_end, first_sample, count)?;
+            let mut pushes = self.background_pushes(start, run_end);
+            let (first, last) = self.lists.covered.range(start, run_end);
+            pushes.push(self.push(Source::Covered, first, last, first_sample, count));
+            let counting = self.noise.is_some();
+            if counting {
+                self.lists.clear_active(start, run_end);
+            }
+            let time = self.dispatch(&pushes)?;
+            if counting {
+                for y in start..run_end {
+                    self.row_active[y as usize] = self.lists.active(y);
+                }
+            }
             total = total.zip(time).map(|(a, b)| a + b);
             self.row_samples[start as usize..run_end as usize].iter_mut().for_each(|n| *n += count);
             start = run_end;
         }
         self.passed |= self.samples() > 0;
         Ok(total)
+    }
+
+    /// Relights the restarted pixels of rows `first_row..end_row` that lag their rows, up to
+    /// `count` samples and no further than their rows' counts: a dispatch per run of rows whose
+    /// restarted pixels have the same count and catch up to the same.
+    fn render_restarted(&mut self, first_row: u32, end_row: u32, count: u32) -> Result<Option<f64>> {
+        let mut restarted = self.restarted.take().expect("called while pixels are restarted");
+        let result = (|| {
+            if !restarted.uploaded {
+                self.lists.upload_restarted(&self.ctx, &restarted.list)?;
+                restarted.uploaded = true;
+            }
+            // Each row's (samples, target), or None where nothing of it is to be relit.
+            let key = |r: &Restarted, y: u32| {
+                r.lags(y, &self.row_samples).then(|| (r.samples[y as usize], self.row_samples[y as usize]))
+            };
+            let mut total = Some(0.0);
+            let mut start = first_row;
+            while start < end_row {
+                let Some((first_sample, target)) = key(&restarted, start) else {
+                    start += 1;
+                    continue;
+                };
+                // Rows without restarted pixels add nothing to the list's range, so may join.
+                let run_end = (start..end_row)
+                    .find(|&y| key(&restarted, y) != Some((first_sample, target)) && restarted.list.row_len(y) > 0)
+                    .unwrap_or(end_row);
+                let n = count.min(target - first_sample);
+                let (first, last) = restarted.list.range(start, run_end);
+                let push = self.push(Source::Restarted, first, last, first_sample, n);
+                let time = self.dispatch(&[push])?;
+                total = total.zip(time).map(|(a, b)| a + b);
+                for y in start..run_end {
+                    if restarted.list.row_len(y) > 0 {
+                        restarted.samples[y as usize] += n;
+                    }
+                }
+                start = run_end;
+            }
+            Ok(total)
+        })();
+        if (0..self.height).any(|y| restarted.lags(y, &self.row_samples)) {
+            self.restarted = Some(restarted);
+        }
+        result
     }
 
     /// Relights the top-left pixel of every `block` × `block` block with sample 0 of the new
@@ -269,7 +460,10 @@ impl Renderer {
         if self.row_samples.iter().any(|&n| n > 0) {
             return Err(crate::Error::gpu("a preview comes before the first pass of an accumulation"));
         }
-        let time = self.dispatch(0, self.height, 0, 1, block)?;
+        let mut pushes = self.background_pushes(0, self.height);
+        let blocks = self.width.div_ceil(block) * self.height.div_ceil(block);
+        pushes.push(RelightPush { block, ..self.push(Source::Preview, 0, blocks, 0, 1) });
+        let time = self.dispatch(&pushes)?;
         // `passed` stays as it was: until a first pass, an A/B split's B half shows A, as it
         // did before previews.
         self.preview = Some(block);
@@ -281,13 +475,23 @@ impl Renderer {
         self.preview
     }
 
-    fn dispatch_relight(&self, first_row: u32, end_row: u32, first_sample: u32, count: u32) -> Result<Option<f64>> {
-        self.dispatch(first_row, end_row, first_sample, count, 1)
+    /// The background pass over rows `first_row..end_row` whose background is not the current
+    /// lighting's (none when all are), marking them done: once per lighting, not per sample.
+    fn background_pushes(&mut self, first_row: u32, end_row: u32) -> Vec<RelightPush> {
+        let stale = |y: &u32| !self.background_rows[*y as usize];
+        let Some(first) = (first_row..end_row).find(stale) else {
+            return Vec::new();
+        };
+        let last = (first_row..end_row).rev().find(stale).expect("found from the front");
+        self.background_rows[first as usize..=last as usize].fill(true);
+        vec![self.push(Source::Background, first * self.width, (last + 1) * self.width, 0, 0)]
     }
 
-    fn dispatch(&self, first_row: u32, end_row: u32, first_sample: u32, count: u32, block: u32) -> Result<Option<f64>> {
+    /// A relight dispatch of `source`'s invocations `first..end`, adding `count` samples to
+    /// pixels that have `first_sample`.
+    fn push(&self, source: Source, first: u32, end: u32, first_sample: u32, count: u32) -> RelightPush {
         let rotation = self.lighting.rotation_degrees.to_radians();
-        let push = RelightPush {
+        RelightPush {
             first_sample,
             sample_count: count,
             seed: self.seed,
@@ -295,11 +499,22 @@ impl Renderer {
             cos_rotation: rotation.cos(),
             sin_rotation: rotation.sin(),
             intensity: self.lighting.intensity,
-            first_row,
-            end_row,
-            block,
-        };
-        self.timed(|renderer, cmd| renderer.relight.record(cmd, renderer.width, &push))
+            source: source as u32,
+            first,
+            end,
+            block: 1,
+            noise_threshold: self.noise.map_or(0.0, |n| n.threshold),
+            min_samples: self.noise.map_or(2, |n| n.min_samples),
+        }
+    }
+
+    /// Runs the relight dispatches `pushes` in one timed submission.
+    fn dispatch(&self, pushes: &[RelightPush]) -> Result<Option<f64>> {
+        self.timed(|renderer, cmd| {
+            for push in pushes {
+                renderer.relight.record(cmd, push);
+            }
+        })
     }
 
     /// Reading the image before the first pass would show whatever an earlier accumulation left.
@@ -435,6 +650,17 @@ impl Renderer {
         Ok(bytemuck::cast_slice(&self.targets.accumulation.read(&self.ctx)?).to_vec())
     }
 
+    /// The samples each pixel has in the current accumulation (its accumulation's alpha), 0
+    /// where uncovered: under a noise threshold, where each pixel stopped.
+    pub fn read_sample_counts(&self) -> Result<Vec<u32>> {
+        let sums = self.read_sums()?;
+        Ok(sums
+            .iter()
+            .zip(&self.lists.covered_mask)
+            .map(|(sum, &covered)| if covered { sum[3] as u32 } else { 0 })
+            .collect())
+    }
+
     /// Each lobe's mean share of the estimate per pixel ([`LOBES`] order), not yet weighted by
     /// coverage: zero where no sample was taken. Needs [`Accumulate::lobes`].
     pub fn read_lobes(&self, coverage: &[f32]) -> Result<Vec<Vec<[f32; 3]>>> {
@@ -500,10 +726,41 @@ impl Renderer {
         self.sampling = sampling;
         self.set_environment(environment)
     }
+
+    /// Uploads new layer stacks and resolves them, as [`Renderer::set_stacks`] does, but
+    /// restarts only the covered pixels whose resolved material changed, bit for bit
+    /// ([`Renderer::restart_pixels`]); every other pixel keeps its samples. Returns how many
+    /// changed: an edit of one object's stack restarts that object's pixels, one of a masked
+    /// layer those where its weight is not 0 (docs/commands.md#edit-local-re-convergence).
+    pub fn set_stacks_local(&mut self, packed: &PackedStacks) -> Result<usize> {
+        self.resolve.set_stacks(&self.ctx, &mut self.gbuffer, packed, &self.targets)?;
+        let (width, height) = (self.width, self.height);
+        self.timed(|renderer, cmd| renderer.resolve.record(cmd, width, height))?;
+        let changed = self.resolve.changed_pixels(width as usize * height as usize)?;
+        self.restart_pixels(&changed);
+        Ok(changed.len())
+    }
 }
 
 /// An environment with the sampling tables `sampling` uses, on the GPU.
 fn upload_environment(ctx: &Context, environment: &Environment, sampling: Sampling) -> Result<GpuEnvironment> {
     let distribution = sampling.distribution(environment, ctx.info().max_image_dimension_2d);
     GpuEnvironment::upload(ctx, environment, &distribution)
+}
+
+/// Pixels restarted alone, catching up with their rows.
+struct Restarted {
+    /// The pixels, row by row.
+    list: RowList,
+    /// The samples each row's restarted pixels have.
+    samples: Vec<u32>,
+    /// Whether the list is on the GPU.
+    uploaded: bool,
+}
+
+impl Restarted {
+    /// Whether row `y`'s restarted pixels have fewer samples than the rest of the row.
+    fn lags(&self, y: u32, row_samples: &[u32]) -> bool {
+        self.list.row_len(y) > 0 && self.samples[y as usize] < row_samples[y as usize]
+    }
 }

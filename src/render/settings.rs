@@ -10,6 +10,38 @@ use crate::{Error, Result};
 /// Samples per pixel when neither the look nor a flag says.
 pub const DEFAULT_SPP: u32 = 256;
 
+/// The least `--min-spp` when none is given: enough samples that the variance estimate that
+/// decides a pixel's stop is itself not too noisy.
+pub const DEFAULT_MIN_SPP: u32 = 16;
+
+/// Adaptive sampling (docs/shading.md#adaptive-sampling): each pixel stops once the estimated
+/// relative error of its mean, tested after `min_samples` and every 8 samples after, is below
+/// `threshold`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NoiseThreshold {
+    /// The relative standard error of the mean luminance at which a pixel stops (0 < t < 1e3).
+    pub threshold: f32,
+    /// The samples every pixel takes before it may stop (at least 2).
+    pub min_samples: u32,
+}
+
+impl NoiseThreshold {
+    /// Checks the values, naming the options they come from.
+    pub fn new(threshold: f32, min_samples: u32) -> Result<NoiseThreshold> {
+        if !(threshold.is_finite() && threshold > 0.0 && threshold < 1e3) {
+            return Err(Error::input(format!(
+                "--noise-threshold {threshold}: must be a number above 0 and below 1000"
+            )));
+        }
+        if min_samples < 2 {
+            return Err(Error::input(format!(
+                "--min-spp {min_samples}: a pixel needs at least 2 samples to estimate its noise"
+            )));
+        }
+        Ok(NoiseThreshold { threshold, min_samples })
+    }
+}
+
 /// Values given on the command line; `None` leaves the look's value.
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
@@ -27,6 +59,10 @@ pub struct Overrides {
     pub aovs: Vec<String>,
     /// `--sampling NAME`: the estimator, instead of the default.
     pub sampling: Option<crate::render::sampling::Sampling>,
+    /// `--noise-threshold X`: adaptive sampling, with `spp` the most a pixel takes.
+    pub noise_threshold: Option<f32>,
+    /// `--min-spp N`: the samples a pixel takes before it may stop ([`DEFAULT_MIN_SPP`]).
+    pub min_spp: Option<u32>,
 }
 
 /// Everything a render needs besides the g-buffer and the stacks.
@@ -45,6 +81,8 @@ pub struct Settings {
     pub aovs: Vec<crate::render::aov::Aov>,
     /// The estimator (docs/shading.md#sampling).
     pub sampling: crate::render::sampling::Sampling,
+    /// Adaptive sampling, when asked for: `spp` is then the most a pixel takes.
+    pub noise: Option<NoiseThreshold>,
 }
 
 impl Settings {
@@ -80,7 +118,22 @@ impl Settings {
         let aov_names =
             if overrides.aovs.is_empty() { render.aovs.clone().unwrap_or_default() } else { overrides.aovs.clone() };
         let aovs = crate::render::aov::Aov::parse_all(&aov_names).map_err(|e| Error::input(format!("--aov: {e}")))?;
+        let noise = match (overrides.noise_threshold, overrides.min_spp) {
+            (None, None) => None,
+            (None, Some(n)) => {
+                return Err(Error::input(format!("--min-spp {n}: only adaptive sampling (--noise-threshold) takes it")))
+            }
+            (Some(_), Some(min_spp)) if min_spp > spp => {
+                return Err(Error::input(format!(
+                    "--min-spp {min_spp}: above the most samples a pixel takes (--spp {spp})"
+                )));
+            }
+            (Some(threshold), Some(min_spp)) => Some(NoiseThreshold::new(threshold, min_spp)?),
+            // With fewer samples than that in all, the pixels take them all.
+            (Some(threshold), None) => Some(NoiseThreshold::new(threshold, DEFAULT_MIN_SPP.min(spp).max(2))?),
+        };
         Ok(Settings {
+            noise,
             aovs,
             model,
             environment: overrides.environment.clone().or_else(|| env.source.clone()),

@@ -247,7 +247,7 @@ impl Running {
     /// How the event loop should wait: not at all while rendering or scripted, else until the
     /// interface next wants a frame or an event comes.
     fn schedule(&mut self) -> ControlFlow {
-        let busy = self.session.samples() < self.session.target()
+        let busy = !self.session.converged()
             || self.script.as_ref().is_some_and(|s| !s.finished())
             || self.exit_after_spp.is_some()
             || !self.queue.is_empty()
@@ -319,7 +319,7 @@ impl Running {
         if capture {
             self.save_screenshots(captured, finishing)?;
         }
-        self.clock.record(started.elapsed(), self.session.samples() < self.session.target());
+        self.clock.record(started.elapsed(), !self.session.converged());
         Ok(())
     }
 
@@ -329,14 +329,16 @@ impl Running {
         self.script.as_ref().is_none_or(|s| s.finished())
             && self.pending.is_none()
             && self.queue.is_empty()
-            && self.session.samples() >= spp
+            && (self.session.samples() >= spp || self.session.converged())
             && self.clock.frames >= 3
     }
 
     /// Queues the script's next action, unless it is waiting for samples.
     fn script_step(&mut self) -> Result<()> {
         let Some(runner) = &mut self.script else { return Ok(()) };
-        let Some((line, step)) = runner.next(self.session.samples(), self.session.target())? else {
+        // Under a noise threshold, a wait for samples ends once every pixel has stopped.
+        let samples = if self.session.converged() { u32::MAX } else { self.session.samples() };
+        let Some((line, step)) = runner.next(samples, self.session.target())? else {
             return Ok(());
         };
         let action = match step {
@@ -616,7 +618,9 @@ impl Running {
 
     fn open_look(&mut self, path: &Path) -> Result<Option<String>> {
         let (look, _, warnings) = load_look_for(path, &self.session.gbuffer, &self.session.gbuffer_name)?;
-        let settings = Settings::resolve(&look, &Overrides::default())?;
+        let mut settings = Settings::resolve(&look, &Overrides::default())?;
+        // Adaptive sampling is the viewer's (`--noise-threshold`), not the look's.
+        settings.noise = self.session.document.settings().noise;
         let mut document = Document::new(look, Some(path.to_path_buf()), settings);
         document.select(initial_selection(&document, self.session.objects()));
         self.session.replace_document(document)?;
@@ -647,6 +651,12 @@ impl Running {
                 placement += &format!("; split at image column {column} ({a} | {b})");
             }
             placement += &self.snapshot_report();
+            if let Some(region) = self.session.restarted_region() {
+                placement += &format!("; {}", super::ui::region_status(region));
+            }
+            if let Some((active, noise)) = self.session.adaptive() {
+                placement += &format!("; adaptive {}: {active} px sampling", noise.threshold);
+            }
             println!(
                 "lookdev: screenshot {} ({}x{} window, {} spp{placement})",
                 path.display(),

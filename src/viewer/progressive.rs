@@ -6,6 +6,10 @@
 //! device, 8×8) block, the smallest block that fits the frame's budget, interpolated to every
 //! pixel. So the whole image shows the new state at once, and the passes replace the preview
 //! band by band: no row ever shows the state before the change.
+//!
+//! An edit of the materials alone restarts only the pixels it changed, with no preview: the
+//! bands relight those pixels alone, the first sweep one sample each, until they have caught up
+//! with the rest (docs/commands.md#edit-local-re-convergence).
 
 use crate::render::Renderer;
 use crate::shading::tonemap::Tonemap;
@@ -70,6 +74,16 @@ pub struct Progressive {
     busy: Duration,
     /// When the current accumulation's preview was shown, and its block size.
     pub preview: Option<(Duration, u32)>,
+    /// Seconds to relight one row's restarted pixels with one sample while they catch up (a
+    /// running average): the rows of a local restart hold few of their pixels.
+    region_row_seconds: f64,
+    /// Whether the restarted pixels have had their first sample: the sweep before it takes one
+    /// sample a band, so they show their new material soonest.
+    region_swept: bool,
+    /// Where the sweep over the restarted pixels' rows is. The pass's own `cursor` stays where
+    /// the edit found it: the rows from there on have one count and those above it one more
+    /// band's, which the restarted pixels catch up with.
+    region_cursor: u32,
 }
 
 impl Progressive {
@@ -83,6 +97,9 @@ impl Progressive {
             pixel_samples: 0.0,
             busy: Duration::ZERO,
             preview: None,
+            region_row_seconds: 0.0,
+            region_swept: false,
+            region_cursor: 0,
         }
     }
 
@@ -99,6 +116,14 @@ impl Progressive {
         self.pixel_samples = 0.0;
         self.busy = Duration::ZERO;
         self.preview = None;
+    }
+
+    /// Starts over after an edit that restarted some pixels only
+    /// ([`Renderer::set_stacks_local`]): the rest keep their samples and the first pass's time.
+    pub fn restart_local(&mut self) {
+        self.region_cursor = 0;
+        self.region_row_seconds = 0.0;
+        self.region_swept = false;
     }
 
     /// The preview's block: the smallest whose one sample per block is expected to fit the
@@ -120,8 +145,12 @@ impl Progressive {
     /// takes one sample per band, so the preview is replaced soonest; later bands take a few.
     /// Returns whether anything was rendered.
     pub fn step(&mut self, renderer: &mut Renderer, target: u32, exposure: f32, tonemap: Tonemap) -> Result<bool> {
-        if renderer.samples() >= target {
+        // Under a noise threshold, accumulation also stops once every pixel has stopped.
+        if renderer.samples() >= target || renderer.active_pixels() == Some(0) {
             return Ok(false);
+        }
+        if let Some((_, theirs, _)) = renderer.restarted_region() {
+            return self.step_region(renderer, theirs, target, exposure, tonemap);
         }
         let height = renderer.height;
         if renderer.preview_block().is_none() && (0..height).all(|row| renderer.row_samples(row) == 0) {
@@ -161,6 +190,41 @@ impl Progressive {
                 self.first_pass = Some(self.started.elapsed());
             }
         }
+        Ok(true)
+    }
+
+    /// Relights the next band of the restarted pixels ([`Renderer::restart_pixels`]), which
+    /// have `theirs` samples: one sample a band until they have all had one, then a few, never
+    /// past the rest's count or `target`.
+    fn step_region(
+        &mut self,
+        renderer: &mut Renderer,
+        theirs: u32,
+        target: u32,
+        exposure: f32,
+        tonemap: Tonemap,
+    ) -> Result<bool> {
+        let Some((first, rows)) = renderer.lagging_rows() else { return Ok(false) };
+        let end = first + rows;
+        if !(first..end).contains(&self.region_cursor) {
+            if self.region_cursor >= end {
+                self.region_swept = true;
+            }
+            self.region_cursor = first;
+        }
+        let count = if self.region_swept { SAMPLES_PER_BAND.min(target.saturating_sub(theirs)).max(1) } else { 1 };
+        let per_row = if self.region_row_seconds > 0.0 { self.region_row_seconds } else { self.row_seconds };
+        let wanted =
+            if per_row > 0.0 { (self.budget.as_secs_f64() / (per_row * count as f64)) as u32 } else { MIN_BAND_ROWS };
+        let band = wanted.max(MIN_BAND_ROWS).min(end - self.region_cursor);
+        let start = Instant::now();
+        renderer.render_rows(self.region_cursor, band, count)?;
+        renderer.finalize_rows(self.region_cursor, band, exposure, tonemap)?;
+        // Not counted in the samples per second, which are of whole rows.
+        let measured = start.elapsed().as_secs_f64() / (band as f64 * count as f64);
+        self.region_row_seconds =
+            if self.region_row_seconds == 0.0 { measured } else { 0.7 * self.region_row_seconds + 0.3 * measured };
+        self.region_cursor += band;
         Ok(true)
     }
 

@@ -13,6 +13,7 @@ use crate::gpu::{Context, Image};
 use crate::material::params::Params;
 use crate::material::stack::{layer_weights, LayerWeight, PackedStacks};
 use crate::render::output::{self, OutputFormat};
+use crate::render::renderer::NoiseThreshold;
 use crate::render::scene::covered_object_ids;
 use crate::render::{Lighting, Renderer};
 use crate::shading::model::Model;
@@ -24,6 +25,8 @@ use std::time::{Duration, Instant};
 
 /// Environments kept loaded, so that undoing a switch does not read the file again.
 const KEPT_ENVIRONMENTS: usize = 3;
+/// Samples a dispatch adds to restarted pixels when a save catches them up.
+const CATCH_UP_SAMPLES: u32 = 16;
 
 /// What the renderer was last given.
 struct Shown {
@@ -34,6 +37,7 @@ struct Shown {
     exposure: f32,
     tonemap: Tonemap,
     model: Model,
+    noise: Option<NoiseThreshold>,
 }
 
 /// Everything known about one pixel, for the inspector.
@@ -167,6 +171,7 @@ impl Session {
         renderer.set_stacks(&packed)?;
         renderer.set_lighting(settings.lighting);
         renderer.set_seed(settings.seed);
+        renderer.set_noise_threshold(settings.noise)?;
         Ok(Session {
             ctx: ctx.clone(),
             progressive: Progressive::new(),
@@ -180,6 +185,7 @@ impl Session {
                 exposure: settings.exposure,
                 tonemap: settings.tonemap,
                 model: settings.model,
+                noise: settings.noise,
             },
             document,
             renderer,
@@ -255,9 +261,29 @@ impl Session {
         self.compare.as_ref().map_or(a, |b| a.min(b.renderer.samples()))
     }
 
+    /// While the pixels an edit restarted alone catch up with the rest (A's): how many they
+    /// are, their samples and the rest's.
+    pub fn restarted_region(&self) -> Option<(usize, u32, u32)> {
+        self.renderer.restarted_region()
+    }
+
     /// Where accumulation stops.
     pub fn target(&self) -> u32 {
         self.target_override.unwrap_or(self.document.settings().spp)
+    }
+
+    /// Whether accumulation has stopped: every pixel has the target's samples, or under a
+    /// noise threshold every pixel has stopped (on both sides of a split).
+    pub fn converged(&self) -> bool {
+        let target = self.target();
+        let done = |r: &Renderer| r.samples() >= target || r.active_pixels() == Some(0);
+        done(&self.renderer) && self.compare.as_ref().is_none_or(|b| done(&b.renderer))
+    }
+
+    /// Under a noise threshold (`--noise-threshold`), A's pixels still taking samples and the
+    /// threshold.
+    pub fn adaptive(&self) -> Option<(u64, NoiseThreshold)> {
+        self.renderer.active_pixels().zip(self.renderer.noise_threshold())
     }
 
     /// What the view shows: the display pixels, or with the display filter on, its pixels.
@@ -369,6 +395,7 @@ impl Session {
         renderer.set_stacks(&packed)?;
         renderer.set_lighting(self.shown.lighting);
         renderer.set_seed(self.shown.seed);
+        renderer.set_noise_threshold(self.shown.noise)?;
         // Its display image starts cleared and is not shown until its first pass has landed
         // (see `compare_ready`).
         let mut progressive = Progressive::new();
@@ -445,11 +472,21 @@ impl Session {
         self.apply_changes(false)
     }
 
-    /// [`Session::sync`]; with `everything`, as if every part had changed.
+    /// [`Session::sync`]; with `everything`, as if every part had changed. A change of the
+    /// materials alone restarts only the pixels whose resolved material it changed; any other
+    /// change restarts every pixel (docs/commands.md#edit-local-re-convergence).
     fn apply_changes(&mut self, everything: bool) -> Result<()> {
         let settings = self.document.settings().clone();
         let mut restarted = false;
+        let mut restarted_locally = false;
         let material_changed = everything || self.document.material_revision() != self.shown.material_revision;
+        // Whether anything but the materials changes every pixel's image.
+        let whole = everything
+            || settings.environment != self.shown.environment
+            || settings.lighting != self.shown.lighting
+            || settings.seed != self.shown.seed
+            || settings.model != self.shown.model
+            || settings.noise != self.shown.noise;
         if material_changed {
             let packed = PackedStacks::pack(
                 self.document.look(),
@@ -458,14 +495,26 @@ impl Session {
                 &self.gbuffer_name,
             )?;
             if everything || packed != self.packed {
-                self.renderer.set_stacks(&packed)?;
+                // Locally only once a first pass has replaced the preview: until then, rows
+                // still shown from it would keep the old materials.
+                if !whole && self.progressive.first_pass.is_some() {
+                    self.renderer.set_stacks_local(&packed)?;
+                    restarted_locally = true;
+                } else {
+                    self.renderer.set_stacks(&packed)?;
+                    restarted = true;
+                }
                 if let Some(b) = self.compare.as_mut().filter(|b| matches!(b.subject, Subject::Model(_))) {
-                    b.renderer.set_stacks(&packed)?;
+                    if !whole && b.progressive.first_pass.is_some() {
+                        b.renderer.set_stacks_local(&packed)?;
+                        b.progressive.restart_local();
+                    } else {
+                        b.renderer.set_stacks(&packed)?;
+                        b.progressive.restart();
+                    }
                     b.packed = packed.clone();
-                    b.progressive.restart();
                 }
                 self.packed = packed;
-                restarted = true;
             }
             self.shown.material_revision = self.document.material_revision();
         }
@@ -497,8 +546,21 @@ impl Session {
             self.shown.model = settings.model;
             restarted = true;
         }
+        if everything || settings.noise != self.shown.noise {
+            self.renderer.set_noise_threshold(settings.noise)?;
+            if let Some(b) = &mut self.compare {
+                b.renderer.set_noise_threshold(settings.noise)?;
+                b.progressive.restart();
+            }
+            self.shown.noise = settings.noise;
+            restarted = true;
+        }
         if restarted {
             self.progressive.restart();
+        } else if restarted_locally {
+            self.progressive.restart_local();
+        }
+        if restarted || restarted_locally {
             self.changed_at = Instant::now();
             self.first_pass_after_change = None;
             self.denoised_at = None;
@@ -550,13 +612,17 @@ impl Session {
         Ok(())
     }
 
-    /// Brings every row to the same sample count (rows may be a band apart mid-pass), so that
-    /// what is saved is a whole number of passes, as `lookdev render` makes.
+    /// Brings every row to the same sample count (rows may be a band apart mid-pass, and
+    /// pixels an edit restarted may still be catching up), so that what is saved is a whole
+    /// number of passes, as `lookdev render` makes.
     fn complete_pass(&mut self) -> Result<()> {
         let settings = self.document.settings();
         let (exposure, tonemap) = (settings.exposure, settings.tonemap);
         while let Some((first, rows)) = self.renderer.lagging_rows() {
-            self.renderer.render_rows(first, rows, 1)?;
+            // Restarted pixels stop at their rows' counts, so may take several samples at once;
+            // lagging rows are one band's samples behind.
+            let count = if self.renderer.restarted_region().is_some() { CATCH_UP_SAMPLES } else { 1 };
+            self.renderer.render_rows(first, rows, count)?;
             self.renderer.finalize_rows(first, rows, exposure, tonemap)?;
         }
         Ok(())

@@ -6,13 +6,15 @@
 //!   with what the AOVs need beside the total;
 //! - [`finalize::FinalizePass`]: the mean, composited over the background, as linear radiance
 //!   and as display pixels (or the viewer's preview, interpolated from one sample per block);
-//! - [`denoise::DenoisePass`]: the viewer's optional display filter of that radiance.
+//! - [`denoise::DenoisePass`]: the viewer's optional display filter of that radiance;
+//! - [`pixel_lists::PixelLists`]: the compacted lists of pixels the relight pass runs over.
 //!
 //! They share the images in [`Targets`] and the g-buffer's surface image
 //! ([`crate::gbuffer::gpu::GpuGBuffer`]).
 
 pub mod denoise;
 pub mod finalize;
+pub mod pixel_lists;
 pub mod relight;
 pub mod resolve;
 

@@ -2,7 +2,8 @@
 //! materials, accumulated per pixel, with each lobe's share and each estimate's squared
 //! luminance beside the total when the AOVs ask for them (docs/formats.md#aovs).
 
-use super::{groups, Targets};
+use super::pixel_lists::PixelLists;
+use super::Targets;
 use crate::environment::{self, GpuEnvironment};
 use crate::gbuffer::gpu::GpuGBuffer;
 use crate::gpu::{
@@ -20,8 +21,9 @@ pub const INTERFACE: Interface =
     Interface::compute(&shaders::RELIGHT, &[&SET, &environment::gpu::SET_LAYOUT], Some(RelightPush::GLSL));
 
 /// Set 0 of `relight.comp`: surface, resolved material, accumulation, background, energy
-/// table, lobe sums, squared luminances. Set 1 is the environment's.
-pub const SET: [BindingKind; 7] = [
+/// table, lobe sums, squared luminances, the covered and restarted pixel lists, and the active
+/// counts. Set 1 is the environment's.
+pub const SET: [BindingKind; 10] = [
     BindingKind::StorageImage,
     BindingKind::StorageImage,
     BindingKind::StorageImage,
@@ -29,13 +31,37 @@ pub const SET: [BindingKind; 7] = [
     BindingKind::StorageBuffer,
     BindingKind::StorageImage,
     BindingKind::StorageImage,
+    BindingKind::StorageImage,
+    BindingKind::StorageImage,
+    BindingKind::StorageBuffer,
 ];
+
+/// Invocations per workgroup (`local_size_x` in relight.comp): a multiple of every subgroup
+/// size in use (8 on lavapipe, 32 or 64 on GPUs).
+const LOCAL_SIZE: u32 = 64;
+
+/// Workgroups per dispatch at most: the least `maxComputeWorkGroupCount[0]` Vulkan allows.
+const MAX_GROUPS: u32 = 65_535;
+
+/// Which pixels a relight dispatch's invocations stand for (`SOURCE_*` in relight.comp).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum Source {
+    /// Entries of the covered list.
+    Covered = 0,
+    /// Entries of the restarted list.
+    Restarted = 1,
+    /// The top-left pixel of each `block` × `block` block, row-major (the preview).
+    Preview = 2,
+    /// Every pixel, row-major: only its background is written.
+    Background = 3,
+}
 
 /// `Pass` in relight.comp.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct RelightPush {
-    /// Samples the band's pixels have; 0 starts a new accumulation.
+    /// Samples the dispatch's pixels have; 0 starts their accumulation.
     pub first_sample: u32,
     pub sample_count: u32,
     pub seed: u32,
@@ -44,15 +70,20 @@ pub struct RelightPush {
     pub cos_rotation: f32,
     pub sin_rotation: f32,
     pub intensity: f32,
-    /// The band this dispatch covers: rows `first_row..end_row`.
-    pub first_row: u32,
-    pub end_row: u32,
-    /// Pixels per side of the block one invocation covers: 1 for a pass, more for a preview,
-    /// which relights each block's top-left pixel only.
+    /// A [`Source`].
+    pub source: u32,
+    /// The invocations' range: list entries, blocks or pixels `first..end`.
+    pub first: u32,
+    pub end: u32,
+    /// Pixels per side of a preview's block.
     pub block: u32,
+    /// Above 0, each pixel stops once its estimated relative error is below it.
+    pub noise_threshold: f32,
+    /// The samples a pixel takes before it may stop (at least 2).
+    pub min_samples: u32,
 }
 
-crate::glsl_struct!(RelightPush as "Pass", 40 bytes {
+crate::glsl_struct!(RelightPush as "Pass", 52 bytes {
     first_sample @ 0,
     sample_count @ 4,
     seed @ 8,
@@ -60,9 +91,12 @@ crate::glsl_struct!(RelightPush as "Pass", 40 bytes {
     cos_rotation @ 16,
     sin_rotation @ 20,
     intensity @ 24,
-    first_row @ 28,
-    end_row @ 32,
-    block @ 36,
+    source @ 28,
+    first @ 32,
+    end @ 36,
+    block @ 40,
+    noise_threshold @ 44,
+    min_samples @ 48,
 });
 
 /// What the relight kernel accumulates beside the total, for the AOVs that need it
@@ -99,6 +133,7 @@ impl RelightPass {
         accumulate: Accumulate,
         gbuffer: &GpuGBuffer,
         targets: &Targets,
+        lists: &PixelLists,
         environment: &GpuEnvironment,
     ) -> Result<RelightPass> {
         let mut constants = model.specialization().to_vec();
@@ -123,6 +158,9 @@ impl RelightPass {
                 Binding::Buffer(&energy_buffer),
                 Binding::Image(&targets.lobe_sums),
                 Binding::Image(&targets.moments),
+                Binding::Image(&lists.covered_image),
+                Binding::Image(&lists.restarted_image),
+                Binding::Buffer(&lists.active),
             ],
         )?;
         let environment_set = pipeline.bind(1, &environment.bindings())?;
@@ -142,16 +180,16 @@ impl RelightPass {
         Ok(())
     }
 
-    /// Records the pass over `width` pixels of the rows `push` names, one invocation per block.
-    pub fn record(&self, cmd: vk::CommandBuffer, width: u32, push: &RelightPush) {
-        let rows = push.end_row - push.first_row;
-        let block = push.block.max(1);
+    /// Records the pass over the invocations `push.first..push.end`, in dispatches of at most
+    /// [`MAX_GROUPS`] workgroups. Their pixels are disjoint, so the dispatches need no barrier.
+    pub fn record(&self, cmd: vk::CommandBuffer, push: &RelightPush) {
         let sets = [&self.set, &self.environment_set];
-        self.pipeline.dispatch(
-            cmd,
-            &sets,
-            bytemuck::bytes_of(push),
-            groups(width.div_ceil(block), rows.div_ceil(block)),
-        );
+        let mut first = push.first;
+        while first < push.end {
+            let end = push.end.min(first.saturating_add(MAX_GROUPS * LOCAL_SIZE));
+            let chunk = RelightPush { first, end, ..*push };
+            self.pipeline.dispatch(cmd, &sets, bytemuck::bytes_of(&chunk), [(end - first).div_ceil(LOCAL_SIZE), 1, 1]);
+            first = end;
+        }
     }
 }

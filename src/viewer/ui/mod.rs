@@ -322,8 +322,17 @@ impl Interface {
         let session = frame.session;
         ui.horizontal(|ui| {
             let (samples, target) = (session.samples(), session.target());
-            let state = if samples >= target { "done" } else { "rendering" };
+            let state = if session.converged() { "done" } else { "rendering" };
             ui.label(format!("{samples} / {target} spp ({state})"));
+            if let Some((active, noise)) = session.adaptive() {
+                ui.separator();
+                ui.label(format!("adaptive {}: {} px sampling", noise.threshold, grouped(active as usize)))
+                    .on_hover_text(ADAPTIVE_HINT);
+            }
+            if let Some(region) = session.restarted_region() {
+                ui.separator();
+                ui.label(region_status(region)).on_hover_text(REGION_HINT);
+            }
             ui.separator();
             let rate = session.progressive.samples_per_second_with(session.compare_progressive());
             ui.label(format!("{:.1} M samples/s", rate / 1e6));
@@ -360,6 +369,31 @@ impl Interface {
     }
 }
 
+/// What the status bar says while the pixels an edit restarted catch up with the rest:
+/// "re-converging 12 345 px: 5/64 spp".
+pub fn region_status((pixels, theirs, rest): (usize, u32, u32)) -> String {
+    format!("re-converging {} px: {theirs}/{rest} spp", grouped(pixels))
+}
+
+/// A count with its digits in groups of three: "12 345".
+fn grouped(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(' ');
+        }
+        out.push(c);
+    }
+    out
+}
+
+const ADAPTIVE_HINT: &str = "--noise-threshold: each pixel stops once the estimated relative error of its mean \
+     luminance is below the threshold; accumulation stops when every pixel has, or at the target spp";
+
+const REGION_HINT: &str = "The edit changed the material of these pixels only: they start again and catch up with \
+     the rest, which keep their samples";
+
 /// Every piece of text in a drawn shape, for tests that draw a panel in a headless egui context.
 #[cfg(test)]
 fn shape_texts(shape: &egui::Shape, out: &mut Vec<String>) {
@@ -367,5 +401,15 @@ fn shape_texts(shape: &egui::Shape, out: &mut Vec<String>) {
         egui::Shape::Text(text) => out.push(text.galley.text().to_string()),
         egui::Shape::Vec(shapes) => shapes.iter().for_each(|s| shape_texts(s, out)),
         _ => {}
+    }
+}
+
+#[cfg(test)]
+mod region_tests {
+    #[test]
+    fn the_restarted_region_reads_with_grouped_digits() {
+        assert_eq!(super::region_status((12345, 5, 64)), "re-converging 12 345 px: 5/64 spp");
+        assert_eq!(super::region_status((999, 0, 16)), "re-converging 999 px: 0/16 spp");
+        assert_eq!(super::region_status((1_048_576, 1, 4)), "re-converging 1 048 576 px: 1/4 spp");
     }
 }

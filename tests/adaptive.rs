@@ -1,0 +1,210 @@
+//! Adaptive sampling (`--noise-threshold`, `Renderer::set_noise_threshold`): each pixel stops
+//! once its estimated relative error is below the threshold, tested at fixed sample counts, so
+//! a flat region stops at the minimum while a noisy one goes on; where each stops, and so the
+//! image, does not depend on how the passes are split; each pixel holds exactly what a uniform
+//! render at its own count holds; and at the same mean sample count its error is lower than
+//! uniform sampling's.
+
+mod common;
+
+use common::cli::{assert_bad_input, assert_success, lookdev, stderr};
+use common::scenes::{look, renderer};
+use lookdev::environment::Environment;
+use lookdev::gbuffer::GBuffer;
+use lookdev::gpu::Context;
+use lookdev::render::progressive;
+use lookdev::render::renderer::NoiseThreshold;
+use lookdev::render::{Lighting, Renderer};
+
+const SIZE: u32 = 64;
+const BALL: u32 = 1;
+
+/// A rough metal ball, noisy under the studio environment, on a black emissive pedestal whose
+/// estimate is its emission and hardly anything else.
+const LOOK: &str = r#"
+[[object]]
+[[object.layer]]
+[object.layer.set]
+base_color = [0.0, 0.0, 0.0]
+specular = 0.0
+emission = [2.0, 1.0, 0.5]
+
+[[object]]
+id = 1
+[[object.layer]]
+[object.layer.set]
+base_color = [0.9, 0.6, 0.3]
+metallic = 1.0
+roughness = 0.35
+"#;
+
+fn scene(ctx: &Context, seed: u32) -> (GBuffer, Renderer) {
+    let gbuffer = GBuffer::shaderball(SIZE, SIZE);
+    let mut r = renderer(ctx, &gbuffer, &Environment::studio(), &look(LOOK), Lighting::default());
+    r.set_seed(seed);
+    (gbuffer, r)
+}
+
+fn bits(values: &[[f32; 4]]) -> Vec<u32> {
+    values.iter().flatten().map(|v| v.to_bits()).collect()
+}
+
+/// The relative MSE of `image` against `reference` over fully covered pixels and rgb.
+fn rel_mse(gbuffer: &GBuffer, image: &[[f32; 4]], reference: &[[f32; 4]]) -> f64 {
+    let (mut total, mut n) = (0.0, 0);
+    for p in (0..image.len()).filter(|&p| gbuffer.coverage[p] == 1.0) {
+        for c in 0..3 {
+            let (x, r) = (image[p][c] as f64, reference[p][c] as f64);
+            total += (x - r) * (x - r) / (r * r + 1e-2);
+            n += 1;
+        }
+    }
+    total / n as f64
+}
+
+#[test]
+fn a_flat_region_stops_at_the_minimum_and_a_noisy_one_goes_on() {
+    let ctx = common::gpu::context();
+    let (gbuffer, mut r) = scene(&ctx, 0);
+    r.set_noise_threshold(Some(NoiseThreshold { threshold: 0.02, min_samples: 16 })).unwrap();
+    assert_eq!(r.active_pixels(), Some(r.covered_pixels() as u64), "every pixel is active before a pass");
+    let stats = progressive::accumulate(&mut r, 256, |_| {}).unwrap();
+    let counts = r.read_sample_counts().unwrap();
+    let covered = |p: &usize| gbuffer.coverage[*p] > 0.0;
+    let pedestal: Vec<u32> =
+        (0..counts.len()).filter(covered).filter(|&p| gbuffer.object_id[p] != BALL).map(|p| counts[p]).collect();
+    let ball: Vec<u32> =
+        (0..counts.len()).filter(covered).filter(|&p| gbuffer.object_id[p] == BALL).map(|p| counts[p]).collect();
+    assert!(!pedestal.is_empty() && !ball.is_empty());
+    assert!(pedestal.iter().all(|&n| n == 16), "the flat pedestal stops at 16: {:?}", pedestal.iter().max());
+    let ball_mean = ball.iter().sum::<u32>() as f64 / ball.len() as f64;
+    assert!(ball_mean > 32.0, "the noisy ball goes on: {ball_mean} spp on average");
+    assert!(ball.iter().all(|&n| n >= 16 && (n == 256 || (n - 16) % 8 == 0)), "stops only at the tests");
+    assert!(ball.iter().any(|&n| n < 256) || r.active_pixels().unwrap() > 0);
+    // The render ends when every pixel has stopped, or at the most samples.
+    assert!(r.active_pixels() == Some(0) || r.samples() == 256);
+    let mean = stats.mean_spp.unwrap();
+    let expected = counts.iter().map(|&n| n as f64).sum::<f64>() / r.covered_pixels() as f64;
+    assert!((mean - expected).abs() < 1e-9, "{mean} vs {expected}");
+    common::gpu::finish(ctx);
+}
+
+#[test]
+fn a_black_region_stops_at_the_minimum() {
+    let ctx = common::gpu::context();
+    let (_, mut r) = scene(&ctx, 0);
+    // No light and no emission: every estimate is 0.
+    r.set_stacks(
+        &lookdev::material::stack::PackedStacks::pack(
+            &look("[[object]]\n[[object.layer]]\n[object.layer.set]\nbase_color = [0.5, 0.5, 0.5]\n"),
+            lookdev::render::scene::covered_object_ids(&GBuffer::shaderball(SIZE, SIZE)),
+            &GBuffer::shaderball(SIZE, SIZE),
+            std::path::Path::new("test g-buffer"),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    r.set_lighting(Lighting { intensity: 0.0, ..Lighting::default() });
+    r.set_noise_threshold(Some(NoiseThreshold { threshold: 0.01, min_samples: 8 })).unwrap();
+    progressive::accumulate(&mut r, 64, |_| {}).unwrap();
+    assert_eq!(r.active_pixels(), Some(0));
+    assert!(r.samples() < 64, "stopped early: no pass after every pixel had stopped");
+    assert!(r.read_sample_counts().unwrap().iter().all(|&n| n == 0 || n == 8));
+    common::gpu::finish(ctx);
+}
+
+/// The same seed gives the same bits under any split into passes and bands, and each pixel
+/// holds what a uniform render at its own count holds.
+#[test]
+fn the_stops_do_not_depend_on_the_split_and_each_pixel_is_a_uniform_render_at_its_count() {
+    let ctx = common::gpu::context();
+    let noise = Some(NoiseThreshold { threshold: 0.03, min_samples: 8 });
+    let max = 40;
+    let (gbuffer, mut batched) = scene(&ctx, 7);
+    batched.set_noise_threshold(noise).unwrap();
+    progressive::accumulate(&mut batched, max, |_| {}).unwrap();
+    let expected = bits(&batched.read_radiance().unwrap());
+    let counts = batched.read_sample_counts().unwrap();
+
+    let (_, mut single) = scene(&ctx, 7);
+    single.set_noise_threshold(noise).unwrap();
+    for _ in 0..max {
+        single.render_samples(1).unwrap();
+    }
+    assert_eq!(bits(&single.read_radiance().unwrap()), expected, "one sample a pass");
+    assert_eq!(single.read_sample_counts().unwrap(), counts);
+
+    let (_, mut banded) = scene(&ctx, 7);
+    banded.set_noise_threshold(noise).unwrap();
+    for (band, count) in [(13, 3), (29, 7), (7, 30)] {
+        let mut first = 0;
+        while first < SIZE {
+            let n = count.min(max - banded.row_samples(first));
+            banded.render_rows(first, band, n).unwrap();
+            first += band;
+        }
+    }
+    assert_eq!(banded.samples(), max);
+    assert_eq!(bits(&banded.read_radiance().unwrap()), expected, "bands");
+
+    let distinct: std::collections::BTreeSet<u32> = counts.iter().copied().filter(|&n| n > 0).collect();
+    assert!(distinct.len() > 1, "some pixels stop early and some go on: {distinct:?}");
+    let radiance = batched.read_radiance().unwrap();
+    for &n in &distinct {
+        let (_, mut uniform) = scene(&ctx, 7);
+        uniform.render_samples(n).unwrap();
+        let reference = uniform.read_radiance().unwrap();
+        for p in (0..counts.len()).filter(|&p| counts[p] == n && gbuffer.coverage[p] == 1.0) {
+            assert_eq!(bits(&[radiance[p]]), bits(&[reference[p]]), "pixel {p} at {n} spp");
+        }
+    }
+    common::gpu::finish(ctx);
+}
+
+/// At the mean sample count adaptive sampling spent, uniform sampling's relative MSE against a
+/// 1024-spp reference of another seed is higher: the threshold buys the same error with fewer
+/// samples. (Counted in samples, not timed.)
+#[test]
+fn at_equal_samples_the_threshold_lowers_the_error() {
+    let ctx = common::gpu::context();
+    let (gbuffer, mut reference) = scene(&ctx, 1000);
+    reference.render_samples(1024).unwrap();
+    let reference = reference.read_radiance().unwrap();
+    let (_, mut adaptive) = scene(&ctx, 3);
+    adaptive.set_noise_threshold(Some(NoiseThreshold { threshold: 0.03, min_samples: 16 })).unwrap();
+    let stats = progressive::accumulate(&mut adaptive, 512, |_| {}).unwrap();
+    let spent = stats.mean_spp.unwrap();
+    let adaptive_error = rel_mse(&gbuffer, &adaptive.read_radiance().unwrap(), &reference);
+    let (_, mut uniform) = scene(&ctx, 3);
+    uniform.render_samples(spent.ceil() as u32).unwrap();
+    let uniform_error = rel_mse(&gbuffer, &uniform.read_radiance().unwrap(), &reference);
+    eprintln!("at {spent:.1} spp on average: adaptive {adaptive_error:.3e}, uniform {uniform_error:.3e}");
+    assert!(
+        adaptive_error < uniform_error,
+        "at {spent:.1} spp on average: adaptive {adaptive_error:.3e}, uniform {uniform_error:.3e}"
+    );
+    common::gpu::finish(ctx);
+}
+
+#[test]
+fn render_takes_a_noise_threshold_and_refuses_bad_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let arg = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let g = arg("g.exr");
+    assert_success(&lookdev(&["gbuffer", "--builtin", "shaderball", "--size", "40", "40", "--out", &g]));
+    let out = arg("a.png");
+    let output = lookdev(&["render", "--gbuffer", &g, "--spp", "64", "--noise-threshold", "0.05", "--out", &out]);
+    assert_success(&output);
+    assert!(stderr(&output).contains("spp on average, at most 64"), "{}", stderr(&output));
+    let frames = arg("t_%02d.png");
+    let args = ["turntable", "--gbuffer", &g, "--frames", "2", "--spp", "32", "--noise-threshold", "0.05"];
+    assert_success(&lookdev(&[&args[..], &["--min-spp", "8", "--quiet", "--out", &frames]].concat()));
+    assert!(dir.path().join("t_02.png").is_file());
+    let render =
+        |extra: &[&str]| lookdev(&[&["render", "--gbuffer", &g, "--spp", "16", "--out", &out][..], extra].concat());
+    assert_bad_input(&render(&["--min-spp", "4"]), &["--min-spp 4", "--noise-threshold"]);
+    assert_bad_input(&render(&["--noise-threshold", "0"]), &["--noise-threshold 0"]);
+    assert_bad_input(&render(&["--noise-threshold", "NaN"]), &["--noise-threshold NaN"]);
+    assert_bad_input(&render(&["--noise-threshold", "0.1", "--min-spp", "1"]), &["--min-spp 1", "at least 2"]);
+    assert_bad_input(&render(&["--noise-threshold", "0.1", "--min-spp", "32"]), &["--min-spp 32", "--spp 16"]);
+}
