@@ -14,7 +14,7 @@
 // same sample 0 a full pass gives it, which overwrites it identically later.
 //
 // With a noise threshold, a pixel stops once its estimated relative error falls below it, tested
-// only at fixed sample counts (min_samples, then every CHECK_EVERY), so where it stops does not
+// only at fixed sample counts (min_samples, then each power of two), so where it stops does not
 // depend on how the samples are split into dispatches (docs/shading.md#adaptive-sampling).
 #extension GL_GOOGLE_include_directive : require
 
@@ -86,8 +86,6 @@ const uint SOURCE_COVERED = 0u;     // entries of the covered list
 const uint SOURCE_RESTARTED = 1u;   // entries of the restarted list
 const uint SOURCE_PREVIEW = 2u;     // the blocks' top-left pixels, row-major
 const uint SOURCE_BACKGROUND = 3u;  // every pixel, row-major: the background only
-// Samples between two stop tests after min_samples.
-const uint CHECK_EVERY = 8u;
 // Below this mean luminance the error is taken relative to it instead, as relative MSE adds
 // 0.01 to r²: dark pixels need no finer an absolute error, and black ones stop.
 const float BLACK = 0.1;
@@ -194,9 +192,10 @@ void write_background(ivec2 pixel) {
     imageStore(background, pixel, vec4(behind, 0.0));
 }
 
-// Whether the stop test runs after `n` samples.
+// Whether the stop test runs after `n` samples: at min_samples, then at each power of two,
+// where the Sobol points of a pixel are best stratified.
 bool checkpoint(uint n) {
-    return n >= pass.min_samples && (n - pass.min_samples) % CHECK_EVERY == 0u;
+    return n == pass.min_samples || (n > pass.min_samples && (n & (n - 1u)) == 0u);
 }
 
 // Whether the standard error of the mean luminance, from the sums of the estimates and of their

@@ -15,7 +15,7 @@ pub const DEFAULT_SPP: u32 = 256;
 pub const DEFAULT_MIN_SPP: u32 = 16;
 
 /// Adaptive sampling (docs/shading.md#adaptive-sampling): each pixel stops once the estimated
-/// relative error of its mean, tested after `min_samples` and every 8 samples after, is below
+/// relative error of its mean, tested after `min_samples` and at each power of two after, is below
 /// `threshold`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NoiseThreshold {
