@@ -6,20 +6,6 @@ mod common;
 
 use common::viewer::{assert_success, Case};
 
-/// Linear radiance of an EXR, as bits.
-fn exr_bits(case: &Case, name: &str) -> Vec<[u32; 4]> {
-    use exr::prelude::{read_first_rgba_layer_from_file, RgbaChannels};
-    let image = read_first_rgba_layer_from_file(
-        case.path(name),
-        |resolution, _: &RgbaChannels| (resolution.width(), vec![[0u32; 4]; resolution.width() * resolution.height()]),
-        |(width, pixels), position, (r, g, b, a): (f32, f32, f32, f32)| {
-            pixels[position.y() * *width + position.x()] = [r, g, b, a].map(f32::to_bits);
-        },
-    )
-    .unwrap();
-    image.layer_data.channel_data.pixels.1
-}
-
 #[test]
 fn the_viewer_stops_where_every_pixel_has_stopped_and_matches_lookdev_render() {
     let Some(case) = Case::new() else { return };
@@ -40,11 +26,11 @@ fn the_viewer_stops_where_every_pixel_has_stopped_and_matches_lookdev_render() {
     render.extend(adaptive);
     render.extend(["--out", "render.exr"]);
     assert_success(&case.command(&render).output().unwrap());
-    assert!(exr_bits(&case, "viewer.exr") == exr_bits(&case, "render.exr"), "the same pixels, bit for bit");
+    assert!(case.exr_bits("viewer.exr") == case.exr_bits("render.exr"), "the same pixels, bit for bit");
 
     let uniform = ["render", "--gbuffer", "g.exr", "--spp", "64", "--quiet", "--out", "u.exr"];
     assert_success(&case.command(&uniform).output().unwrap());
-    assert!(exr_bits(&case, "u.exr") != exr_bits(&case, "render.exr"), "adaptive sampling took fewer samples");
+    assert!(case.exr_bits("u.exr") != case.exr_bits("render.exr"), "adaptive sampling took fewer samples");
 }
 
 #[test]

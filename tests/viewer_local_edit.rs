@@ -24,20 +24,6 @@ fn view_slowly(case: &Case, script: &str) -> Output {
     output
 }
 
-/// Linear radiance of an EXR the viewer or `lookdev render` wrote, as bits, row by row.
-fn exr_bits(case: &Case, name: &str) -> Vec<[u32; 4]> {
-    use exr::prelude::{read_first_rgba_layer_from_file, RgbaChannels};
-    let image = read_first_rgba_layer_from_file(
-        case.path(name),
-        |resolution, _: &RgbaChannels| (resolution.width(), vec![[0u32; 4]; resolution.width() * resolution.height()]),
-        |(width, pixels), position, (r, g, b, a): (f32, f32, f32, f32)| {
-            pixels[position.y() * *width + position.x()] = [r, g, b, a].map(f32::to_bits);
-        },
-    )
-    .unwrap();
-    image.layer_data.channel_data.pixels.1
-}
-
 /// The screenshot line that names `name`.
 fn screenshot_line(output: &Output, name: &str) -> String {
     let stdout = String::from_utf8_lossy(&output.stdout);
@@ -86,7 +72,7 @@ fn an_edit_of_the_pedestal_restarts_only_its_pixels_and_ends_as_a_fresh_render()
 
     // Caught up: the ball's pixels and the background are as before, bit for bit, and the
     // image is `lookdev render`'s of the edited look.
-    let (before, after) = (exr_bits(&case, "before.exr"), exr_bits(&case, "after.exr"));
+    let (before, after) = (case.exr_bits("before.exr"), case.exr_bits("after.exr"));
     for i in (0..gbuffer.pixel_count()).filter(|i| pedestal.binary_search(i).is_err()) {
         assert_eq!(before[i], after[i], "pixel {i} (object {}) kept its samples", gbuffer.object_id[i]);
     }
@@ -95,12 +81,9 @@ fn an_edit_of_the_pedestal_restarts_only_its_pixels_and_ends_as_a_fresh_render()
     let spp = SPP.to_string();
     let render = ["render", "--gbuffer", "g.exr", "--look", "edited.toml", "--spp", &spp, "--quiet", "--out", "r.exr"];
     assert_success(&case.command(&render).output().unwrap());
-    assert!(
-        after == exr_bits(&case, "r.exr"),
-        "the viewer's image is lookdev render's of the edited look, bit for bit"
-    );
+    assert!(after == case.exr_bits("r.exr"), "the viewer's image is lookdev render's of the edited look, bit for bit");
     // Undone the same way, the first image comes back.
-    assert!(exr_bits(&case, "undone.exr") == before, "undone: the first image, bit for bit");
+    assert!(case.exr_bits("undone.exr") == before, "undone: the first image, bit for bit");
 }
 
 #[test]
@@ -153,5 +136,5 @@ fn an_edit_in_the_middle_of_a_pass_ends_as_a_fresh_render() {
     let spp = SPP.to_string();
     let render = ["render", "--gbuffer", "g.exr", "--look", "edited.toml", "--spp", &spp, "--quiet", "--out", "r.exr"];
     assert_success(&case.command(&render).output().unwrap());
-    assert!(exr_bits(&case, "after.exr") == exr_bits(&case, "r.exr"), "{}", common::viewer::stderr(&output));
+    assert!(case.exr_bits("after.exr") == case.exr_bits("r.exr"), "{}", common::viewer::stderr(&output));
 }

@@ -3,7 +3,7 @@
 //! at the new state: by a first full-resolution pass, as the viewer showed it before it had a
 //! preview (a lower bound: it swept the pass in bands, a frame each), and by the preview, one
 //! sample per block. See
-//! docs/commands.md#lookdev-bench---device-name---spp-n---passes-n---aov-name---interactive---edits-n---adaptive---gbuffer-file.
+//! docs/commands.md#lookdev-bench---device-name---spp-n---passes-n---aov-name---interactive---edits-n.
 //!
 //! With `--local-edit`, it measures edit-local re-convergence instead: the time from an edit of
 //! one object's stack until that object is back at the sample count it had, against the time a

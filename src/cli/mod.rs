@@ -3,8 +3,8 @@
 
 mod bake;
 mod bench;
-mod bench_convergence;
 mod bench_adaptive;
+mod bench_convergence;
 mod bench_interactive;
 mod brdf;
 mod gbuffer;
