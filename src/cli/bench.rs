@@ -42,10 +42,6 @@ pub struct BenchArgs {
     /// wall time, mean spp and relative MSE against a 2048-spp reference of another seed.
     #[arg(long)]
     pub adaptive: bool,
-    /// With --adaptive: this g-buffer (e.g. a baked asset, in the default material) instead of
-    /// the built-in shader ball at 256x256.
-    #[arg(long, value_name = "FILE.exr", requires = "adaptive")]
-    pub gbuffer: Option<std::path::PathBuf>,
     /// With --interactive: instead, the time from an edit of one object's stack until that
     /// object is back at 16 spp (the rest keeping their samples), against a full restart's.
     #[arg(long, requires = "interactive")]

@@ -7,12 +7,10 @@
 use super::bench::BenchArgs;
 use crate::render::progressive;
 use crate::render::renderer::NoiseThreshold;
-use crate::render::scene::{GBufferSpec, Scene, SceneSpec};
+use crate::render::scene::Scene;
 use crate::render::Renderer;
 use crate::Result;
 
-/// The built-in scene's side: small enough for the reference's 2048 spp on a CPU driver.
-const SIDE: u32 = 256;
 const REFERENCE_SPP: u32 = 2048;
 const UNIFORM_SPP: [u32; 8] = [8, 16, 32, 64, 128, 256, 512, 1024];
 const THRESHOLDS: [f32; 4] = [0.1, 0.05, 0.03, 0.02];
@@ -30,21 +28,11 @@ struct Row {
 pub fn run(args: &BenchArgs) -> Result<()> {
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
-    let builtin_size = args.gbuffer.is_none().then_some((SIDE, SIDE));
-    let scene = Scene::load(&SceneSpec {
-        gbuffer: GBufferSpec { file: args.gbuffer.clone(), builtin_size, ..GBufferSpec::default() },
-        quiet: true,
-        ..SceneSpec::default()
-    })?;
+    let scene = Scene::load(&args.convergence_args.scene_spec()?)?;
     scene.check_device(ctx.info())?;
     let gbuffer = &scene.gbuffer;
     println!("device: {}", ctx.info().name);
-    println!(
-        "scene: {} ({}x{}), default look and environment",
-        scene.gbuffer_name.display(),
-        gbuffer.width,
-        gbuffer.height
-    );
+    println!("scene: {} ({}x{})", scene.gbuffer_name.display(), gbuffer.width, gbuffer.height);
     let mut renderer = Renderer::with_model(&ctx, gbuffer, &scene.environment, &scene.settings.model)?;
     renderer.set_stacks(&scene.stacks)?;
     renderer.set_lighting(scene.settings.lighting);
@@ -60,17 +48,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let (reference, row) = render(1, REFERENCE_SPP, None)?;
     println!("reference: {REFERENCE_SPP} spp, seed 1, {:.1} s", row.seconds);
     let full: Vec<bool> = gbuffer.coverage.iter().map(|&a| a == 1.0).collect();
-    let rel_mse = |image: &[[f32; 4]]| {
-        let (mut total, mut n) = (0.0, 0u64);
-        for ((x, r), _) in image.iter().zip(&reference).zip(&full).filter(|(_, &f)| f) {
-            for c in 0..3 {
-                let (x, r) = (x[c] as f64, r[c] as f64);
-                total += (x - r) * (x - r) / (r * r + 1e-2);
-                n += 1;
-            }
-        }
-        total / n.max(1) as f64
-    };
+    let rel_mse = |image: &[[f32; 4]]| super::bench_convergence::relative_mse(image, &reference, &gbuffer.coverage);
     // The bias, with noise: the image's sum over fully covered pixels and rgb against the
     // reference's, less 1.
     let sum = |image: &[[f32; 4]]| -> f64 {

@@ -22,24 +22,24 @@ const REFERENCE_SEED: u32 = 0x9e37_79b9;
 /// What `--convergence` renders and how.
 #[derive(Args, Debug)]
 pub struct ConvergenceArgs {
-    /// With --convergence: the look (default: the built-in default look).
+    /// With --convergence or --adaptive: the look (default: the built-in default look).
     #[arg(long, value_name = "FILE.toml")]
     pub look: Option<PathBuf>,
     #[command(flatten)]
     pub gbuffer: GBufferArgs,
-    /// With --convergence: the environment, as `render --env` takes it.
+    /// With --convergence or --adaptive: the environment, as `render --env` takes it.
     #[arg(long, value_name = "FILE.exr|.hdr|NAME", value_parser = EnvironmentRef::parse)]
     pub env: Option<EnvironmentRef>,
-    /// With --convergence: environment rotation about +Y, in degrees.
+    /// With --convergence or --adaptive: environment rotation about +Y, in degrees.
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     pub rotation: Option<f32>,
-    /// With --convergence: override a parameter on every layer, e.g. --set metallic=1.
+    /// With --convergence or --adaptive: override a parameter on every layer, e.g. --set metallic=1.
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
-    /// With --convergence: a BRDF model variant, as `render --model` takes it.
+    /// With --convergence or --adaptive: a BRDF model variant, as `render --model` takes it.
     #[arg(long = "model", value_name = "KEY=VALUE")]
     pub model: Vec<String>,
-    /// With --convergence: the built-in shader ball's size (not with --gbuffer).
+    /// With --convergence or --adaptive: the built-in shader ball's size (not with --gbuffer).
     #[arg(long, num_args = 2, value_names = ["W", "H"], default_values_t = [256, 256])]
     pub size: Vec<u32>,
     /// With --convergence: samples per pixel of the reference.
@@ -77,14 +77,6 @@ pub fn relative_mse(image: &[[f32; 4]], reference: &[[f32; 4]], coverage: &[f32]
 
 impl ConvergenceArgs {
     fn spec(&self) -> Result<SceneSpec> {
-        let [width, height] = self.size[..] else {
-            return Err(Error::input("--size takes a width and a height, e.g. --size 256 256"));
-        };
-        if !(1..=MAX_BUILTIN_SIDE).contains(&width) || !(1..=MAX_BUILTIN_SIDE).contains(&height) {
-            return Err(Error::input(format!(
-                "--size {width} {height}: each side must be 1 to {MAX_BUILTIN_SIDE} pixels"
-            )));
-        }
         let max = self.convergence_spp.iter().copied().max().unwrap_or(0);
         if self.convergence_spp.contains(&0) || max == 0 {
             return Err(Error::input("--convergence-spp: each sample count must be at least 1"));
@@ -93,6 +85,20 @@ impl ConvergenceArgs {
             return Err(Error::input(format!(
                 "--reference-spp {}: the reference needs more samples than the largest --convergence-spp ({max})",
                 self.reference_spp
+            )));
+        }
+        self.scene_spec()
+    }
+
+    /// The scene measured, as `--convergence` and `--adaptive` take it: the built-in shader ball
+    /// at `--size`, or the g-buffer, look, environment and overrides given.
+    pub fn scene_spec(&self) -> Result<SceneSpec> {
+        let [width, height] = self.size[..] else {
+            return Err(Error::input("--size takes a width and a height, e.g. --size 256 256"));
+        };
+        if !(1..=MAX_BUILTIN_SIDE).contains(&width) || !(1..=MAX_BUILTIN_SIDE).contains(&height) {
+            return Err(Error::input(format!(
+                "--size {width} {height}: each side must be 1 to {MAX_BUILTIN_SIDE} pixels"
             )));
         }
         Ok(SceneSpec {

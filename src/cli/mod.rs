@@ -225,4 +225,21 @@ mod tests {
         );
         assert_eq!(catching_panics(|| Err(Error::input("bad")), || None).unwrap_err().exit_code(), 2);
     }
+
+    /// No two of a command's flags share a long name: a flattened group of flags would
+    /// otherwise shadow another silently (clap checks this only in debug builds).
+    #[test]
+    fn no_two_flags_of_a_command_share_a_name() {
+        fn check(command: &clap::Command, path: &str) {
+            let mut seen = std::collections::HashSet::new();
+            for long in command.get_arguments().filter_map(|a| a.get_long()) {
+                assert!(seen.insert(long), "{path}: --{long} is declared twice");
+            }
+            for sub in command.get_subcommands() {
+                check(sub, &format!("{path} {}", sub.get_name()));
+            }
+        }
+        use clap::CommandFactory;
+        check(&Cli::command(), "lookdev");
+    }
 }
