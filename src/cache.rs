@@ -107,12 +107,8 @@ impl Entry {
         // The file's size is checked against the cap before reading, and the header's lengths
         // against the file's, so a hostile file cannot make this allocate more than the cap.
         let cap = (HEADER + MAX_KEY) as u64 + self.max_payload;
-        let bytes = match input::read_bytes(path, Kind::Cache) {
-            Ok(bytes) if bytes.len() as u64 <= cap => bytes,
-            Ok(bytes) => {
-                damaged(path, &format!("it is {}, more than such a file can be", input::size_text(bytes.len() as u64)));
-                return None;
-            }
+        let bytes = match input::read_bytes_at_most(path, Kind::Cache, cap) {
+            Ok(bytes) => bytes,
             Err(problem) => {
                 damaged(path, &problem);
                 return None;

@@ -91,20 +91,26 @@ pub fn read_text(path: &Path, kind: Kind) -> Result<String> {
 /// Like [`read`], but returns only the problem, for callers that name the file in their own
 /// words (a glTF buffer is reported as the asset's, with the buffer's label).
 pub fn read_bytes(path: &Path, kind: Kind) -> std::result::Result<Vec<u8>, String> {
+    read_bytes_at_most(path, kind, kind.cap())
+}
+
+/// Like [`read_bytes`], with a cap below the kind's: for a caller that knows a tighter limit
+/// before reading (a cache entry of one kind), so that a larger file is refused unread.
+pub fn read_bytes_at_most(path: &Path, kind: Kind, cap: u64) -> std::result::Result<Vec<u8>, String> {
+    let cap = cap.min(kind.cap());
     let file = open(path)?;
     let meta = file.metadata().map_err(|e| format!("cannot read the file ({e})"))?;
     if !meta.is_file() {
         return Err(format!("not a regular file ({}); lookdev reads only regular files", file_type(&meta)));
     }
-    let cap = kind.cap();
     if meta.len() > cap {
-        return Err(too_large(meta.len(), kind));
+        return Err(too_large(meta.len(), cap, kind));
     }
     let mut bytes = Vec::with_capacity(meta.len() as usize);
     // One byte more than the cap tells a file that grew past it from one that fills it.
     file.take(cap + 1).read_to_end(&mut bytes).map_err(|e| format!("cannot read the file ({e})"))?;
     if bytes.len() as u64 > cap {
-        return Err(too_large(bytes.len() as u64, kind));
+        return Err(too_large(bytes.len() as u64, cap, kind));
     }
     Ok(bytes)
 }
@@ -126,13 +132,8 @@ fn open(path: &Path) -> std::result::Result<File, String> {
     })
 }
 
-fn too_large(len: u64, kind: Kind) -> String {
-    format!(
-        "the file is {}, larger than the {} lookdev reads as {}",
-        size_text(len),
-        size_text(kind.cap()),
-        kind.what()
-    )
+fn too_large(len: u64, cap: u64, kind: Kind) -> String {
+    format!("the file is {}, larger than the {} lookdev reads as {}", size_text(len), size_text(cap), kind.what())
 }
 
 /// A byte count for messages: `3.2 MiB`, `512 bytes`.
@@ -209,5 +210,21 @@ mod tests {
         std::fs::write(&latin1, b"# ok\nname = \"caf\xe9\"\n").unwrap();
         let message = read_text(&latin1, Kind::Toml).unwrap_err().to_string();
         assert!(message.ends_with("latin1.toml:2: the file is not UTF-8 text"), "{message}");
+    }
+
+    #[test]
+    fn a_tighter_cap_refuses_a_file_before_reading_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let entry = dir.path().join("entry.bin");
+        // Sparse: 256 MiB that take no disk, under the kind's own cap but over this caller's.
+        std::fs::File::create(&entry).unwrap().set_len(256 * MIB).unwrap();
+        let message = read_bytes_at_most(&entry, Kind::Cache, 1024).unwrap_err();
+        assert!(message.contains("is 256.0 MiB, larger than the 1.0 KiB lookdev reads as a cache file"), "{message}");
+        std::fs::File::create(&entry).unwrap().set_len(1024).unwrap();
+        assert_eq!(read_bytes_at_most(&entry, Kind::Cache, 1024).unwrap().len(), 1024);
+        // The kind's cap still bounds a looser one.
+        std::fs::File::create(&entry).unwrap().set_len(5 * MIB).unwrap();
+        let message = read_bytes_at_most(&entry, Kind::Toml, u64::MAX).unwrap_err();
+        assert!(message.contains("larger than the 4.0 MiB lookdev reads as a TOML file"), "{message}");
     }
 }
