@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::cli::{assert_bad_input, assert_success, lookdev, stderr};
+use common::cli::{assert_bad_input, assert_success, exr_bits, lookdev, stderr};
 use common::scenes::{look, renderer};
 use lookdev::environment::Environment;
 use lookdev::gbuffer::GBuffer;
@@ -206,5 +206,44 @@ fn render_takes_a_noise_threshold_and_refuses_bad_values() {
     assert_bad_input(&render(&["--noise-threshold", "0"]), &["--noise-threshold 0"]);
     assert_bad_input(&render(&["--noise-threshold", "NaN"]), &["--noise-threshold NaN"]);
     assert_bad_input(&render(&["--noise-threshold", "0.1", "--min-spp", "1"]), &["--min-spp 1", "at least 2"]);
-    assert_bad_input(&render(&["--noise-threshold", "0.1", "--min-spp", "32"]), &["--min-spp 32", "--spp 16"]);
+    assert_bad_input(
+        &render(&["--noise-threshold", "0.1", "--min-spp", "32"]),
+        &["--min-spp 32", "above spp, the most samples a pixel takes (16)"],
+    );
+}
+
+#[test]
+fn a_look_can_ask_for_adaptive_sampling() {
+    let dir = tempfile::tempdir().unwrap();
+    let arg = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let g = arg("g.exr");
+    assert_success(&lookdev(&["gbuffer", "--builtin", "shaderball", "--size", "40", "40", "--out", &g]));
+    let look = |name: &str, render: &str| {
+        let path = arg(name);
+        std::fs::write(&path, format!("[render]\nspp = 64\n{render}")).unwrap();
+        path
+    };
+    let adaptive = look("adaptive.toml", "noise_threshold = 0.05\nmin_spp = 8\n");
+    let render = |look: &str, extra: &[&str]| {
+        let out = arg("a.exr");
+        lookdev(&[&["render", "--gbuffer", &g, "--look", look, "--out", &out][..], extra].concat())
+    };
+    let output = render(&adaptive, &[]);
+    assert_success(&output);
+    assert!(stderr(&output).contains("spp on average, at most 64"), "{}", stderr(&output));
+    // The look's values are those of the flags: the same image, bit for bit.
+    let pixels = || exr_bits(&dir.path().join("a.exr"));
+    let from_look = pixels();
+    assert_success(&render(&look("plain.toml", ""), &["--noise-threshold", "0.05", "--min-spp", "8"]));
+    assert!(pixels() == from_look);
+    // A flag overrides the look's threshold.
+    let output = render(&adaptive, &["--noise-threshold", "0.5"]);
+    assert_success(&output);
+    assert!(pixels() != from_look);
+
+    let lone = look("lone.toml", "min_spp = 8\n");
+    assert_bad_input(&render(&lone, &[]), &["lone.toml: [render] min_spp = 8", "only adaptive sampling"]);
+    let over = look("over.toml", "noise_threshold = 0.1\nmin_spp = 128\n");
+    assert_bad_input(&render(&over, &[]), &["over.toml: [render] min_spp = 128", "above spp"]);
+    assert_success(&render(&over, &["--min-spp", "16"]));
 }

@@ -566,6 +566,22 @@ fn settings_left_at_their_defaults_add_no_tables() {
 }
 
 #[test]
+fn a_noise_threshold_given_on_the_command_line_is_saved_with_the_look() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("adaptive.toml");
+    let look = Look::parse("[render]\nspp = 128\n[[object]]\n[[object.layer]]\npreset = \"wax\"\n", &path).unwrap();
+    let overrides = Overrides { noise_threshold: Some(0.05), ..Overrides::default() };
+    let settings = Settings::resolve(&look, &overrides).unwrap();
+    let mut doc = Document::new(look, Some(path.clone()), settings);
+    doc.save(None).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.starts_with("[render]\nspp = 128\nnoise_threshold = 0.05\n"), "{text}");
+    assert!(!text.contains("min_spp"), "the default minimum is left out: {text}");
+    let reopened = Look::load(&path).unwrap();
+    assert_eq!(&Settings::resolve(&reopened, &Overrides::default()).unwrap(), doc.settings());
+}
+
+#[test]
 fn saving_elsewhere_keeps_what_references_mean_and_undo_follows() {
     let dir = tempfile::tempdir().unwrap();
     let old = dir.path().join("old/shot.toml");

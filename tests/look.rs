@@ -53,7 +53,7 @@ fn toml_syntax_errors_carry_the_parsers_line() {
 fn unknown_keys_name_the_table_and_the_expected_keys() {
     assert_eq!(
         error("\n[render]\nsppp = 4\n"),
-        "looks/shot.toml:3: unknown key 'sppp' in [render] (expected spp, seed, exposure, tonemap, aovs); did you mean 'spp'?"
+        "looks/shot.toml:3: unknown key 'sppp' in [render] (expected spp, seed, exposure, tonemap, aovs, noise_threshold, min_spp); did you mean 'spp'?"
     );
     assert_eq!(
         error("[environment]\nfile = \"a.exr\"\n\nrotaton = 3\n"),
@@ -151,6 +151,15 @@ fn environment_and_render_values_are_checked() {
         error("[render]\naovs = \"N\"\n"),
         "looks/shot.toml:2: aovs must be an array of strings, not the string \"N\""
     );
+    assert_eq!(
+        error("[render]\nnoise_threshold = 0\n"),
+        "looks/shot.toml:2: noise_threshold = 0 must be above 0 and below 1000"
+    );
+    assert_eq!(
+        error("[render]\nnoise_threshold = nan\n"),
+        "looks/shot.toml:2: noise_threshold = NaN is not a finite number"
+    );
+    assert_eq!(error("[render]\nmin_spp = 1\n"), "looks/shot.toml:2: min_spp = 1 is out of range [2, 4294967295]");
 }
 
 #[test]
@@ -331,6 +340,8 @@ spp = 64
 seed = 4294967295
 exposure = -1.5
 tonemap = "agx"
+noise_threshold = 0.05
+min_spp = 8
 
 [[object]]
 id = 7
@@ -354,9 +365,11 @@ base_color = [1, 0.5, 0]
     assert_eq!(look.render.seed, Some(u32::MAX));
     assert_eq!(look.render.exposure, Some(-1.5));
     assert_eq!(look.render.tonemap, Some(Tonemap::Agx));
+    assert_eq!(look.render.noise_threshold, Some(0.05));
+    assert_eq!(look.render.min_spp, Some(8));
     let stack = look.stack_for(7).unwrap();
     let gold = &stack.layers[1];
-    assert_eq!(gold.line, 18);
+    assert_eq!(gold.line, 20);
     assert_eq!(gold.mask.as_deref(), Some("scratches"));
     assert!(gold.invert);
     assert_eq!(gold.opacity, 0.25);
@@ -380,6 +393,8 @@ background = true
 seed = 3
 tonemap = "aces"
 aovs = ["light", "N"]
+noise_threshold = 0.025
+min_spp = 32
 [[object]]
 [[object.layer]]
 [object.layer.set]
@@ -411,7 +426,7 @@ emission = "glow"
     assert_eq!(maps, [(Param::BaseColor, "albedo"), (Param::Roughness, "metalRough.G"), (Param::Emission, "glow")]);
     assert_eq!(look.render.aovs.as_deref(), Some(&["light".to_string(), "N".to_string()][..]));
     let written = look.to_toml();
-    assert!(written.contains("aovs = [\"light\", \"N\"]"), "{written}");
+    assert!(written.contains("aovs = [\"light\", \"N\"]\nnoise_threshold = 0.025\nmin_spp = 32\n"), "{written}");
     assert!(written.contains("[object.layer.map]\nbase_color = \"albedo\"\nroughness = \"metalRough.G\""), "{written}");
     let again = Look::parse(&written, &path).unwrap();
     assert_eq!(again, look, "{written}");

@@ -66,6 +66,11 @@ pub struct RenderSettings {
     pub tonemap: Option<Tonemap>,
     /// The AOVs renders write beside the beauty (docs/formats.md#aovs), as written.
     pub aovs: Option<Vec<String>>,
+    /// Adaptive sampling's threshold (docs/shading.md#adaptive-sampling): `spp` is then the
+    /// most a pixel takes. Within (0, 1000).
+    pub noise_threshold: Option<f32>,
+    /// The samples every pixel takes before it may stop, ≥ 2; only with `noise_threshold`.
+    pub min_spp: Option<u32>,
 }
 
 /// One `[[object]]`: the layer stack for an object id, or the default stack.
@@ -387,6 +392,10 @@ impl Look {
             let names: Vec<String> = aovs.iter().map(|a| input::quoted(a)).collect();
             body.push(format!("aovs = [{}]", names.join(", ")));
         }
+        push_float(&mut body, "noise_threshold", render.noise_threshold);
+        if let Some(min_spp) = render.min_spp {
+            body.push(format!("min_spp = {min_spp}"));
+        }
         push_section(lines, "[render]", body);
     }
 }
@@ -502,6 +511,8 @@ struct RenderFile {
     exposure: Option<Field>,
     tonemap: Option<Field>,
     aovs: Option<Field>,
+    noise_threshold: Option<Field>,
+    min_spp: Option<Field>,
 }
 
 #[derive(Deserialize)]
@@ -612,6 +623,8 @@ fn render(src: &Source, raw: Option<RenderFile>) -> crate::Result<RenderSettings
         exposure: src.read("exposure", &raw.exposure, exposure)?,
         tonemap: src.read("tonemap", &raw.tonemap, tonemap)?,
         aovs: src.read("aovs", &raw.aovs, aov_names)?,
+        noise_threshold: src.read("noise_threshold", &raw.noise_threshold, noise_threshold)?,
+        min_spp: src.read("min_spp", &raw.min_spp, |k, v| input::unsigned(k, v, 2))?,
     })
 }
 
@@ -747,6 +760,15 @@ fn exposure(key: &str, value: &toml::Value) -> Result<f32, String> {
         Ok(x)
     } else {
         Err(format!("{key} = {} must be within ±{MAX_EXPOSURE} stops", crate::number_text(x)))
+    }
+}
+
+fn noise_threshold(key: &str, value: &toml::Value) -> Result<f32, String> {
+    let x = input::number(key, value)?;
+    if x > 0.0 && x < 1e3 {
+        Ok(x)
+    } else {
+        Err(format!("{key} = {} must be above 0 and below 1000", crate::number_text(x)))
     }
 }
 

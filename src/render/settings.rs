@@ -118,20 +118,7 @@ impl Settings {
         let aov_names =
             if overrides.aovs.is_empty() { render.aovs.clone().unwrap_or_default() } else { overrides.aovs.clone() };
         let aovs = crate::render::aov::Aov::parse_all(&aov_names).map_err(|e| Error::input(format!("--aov: {e}")))?;
-        let noise = match (overrides.noise_threshold, overrides.min_spp) {
-            (None, None) => None,
-            (None, Some(n)) => {
-                return Err(Error::input(format!("--min-spp {n}: only adaptive sampling (--noise-threshold) takes it")))
-            }
-            (Some(_), Some(min_spp)) if min_spp > spp => {
-                return Err(Error::input(format!(
-                    "--min-spp {min_spp}: above the most samples a pixel takes (--spp {spp})"
-                )));
-            }
-            (Some(threshold), Some(min_spp)) => Some(NoiseThreshold::new(threshold, min_spp)?),
-            // With fewer samples than that in all, the pixels take them all.
-            (Some(threshold), None) => Some(NoiseThreshold::new(threshold, DEFAULT_MIN_SPP.min(spp).max(2))?),
-        };
+        let noise = noise_threshold(look, overrides, spp)?;
         Ok(Settings {
             noise,
             aovs,
@@ -148,5 +135,30 @@ impl Settings {
             tonemap: overrides.tonemap.or(render.tonemap).unwrap_or_default(),
             sampling: overrides.sampling.unwrap_or_default(),
         })
+    }
+}
+
+/// Adaptive sampling as the flags, else the look's `[render]`, ask for it. Each value's
+/// problem names where it came from: the flag, or the look's file.
+fn noise_threshold(look: &Look, overrides: &Overrides, spp: u32) -> Result<Option<NoiseThreshold>> {
+    let render = &look.render;
+    let look_file = || look.file.as_deref().map_or("the look".to_string(), |f| f.display().to_string());
+    let min_spp = match (overrides.min_spp, render.min_spp) {
+        (Some(n), _) => Some((n, format!("--min-spp {n}"))),
+        (None, Some(n)) => Some((n, format!("{}: [render] min_spp = {n}", look_file()))),
+        (None, None) => None,
+    };
+    let threshold = overrides.noise_threshold.or(render.noise_threshold);
+    match (threshold, min_spp) {
+        (None, None) => Ok(None),
+        (None, Some((_, source))) => {
+            Err(Error::input(format!("{source}: only adaptive sampling (--noise-threshold) takes it")))
+        }
+        (Some(_), Some((min_spp, source))) if min_spp > spp => {
+            Err(Error::input(format!("{source}: above spp, the most samples a pixel takes ({spp})")))
+        }
+        (Some(threshold), Some((min_spp, _))) => NoiseThreshold::new(threshold, min_spp).map(Some),
+        // With fewer samples than that in all, the pixels take them all.
+        (Some(threshold), None) => NoiseThreshold::new(threshold, DEFAULT_MIN_SPP.min(spp).max(2)).map(Some),
     }
 }

@@ -6,7 +6,7 @@ use std::fmt;
 use crate::environment::EnvironmentRef;
 use crate::material::look::{EnvironmentSettings, Layer, Look, ObjectStack, RenderSettings};
 use crate::material::params::{Param, Params, Value};
-use crate::render::settings::{Settings, DEFAULT_SPP};
+use crate::render::settings::{Settings, DEFAULT_MIN_SPP, DEFAULT_SPP};
 use crate::render::Lighting;
 use crate::shading::model::Model;
 use crate::shading::tonemap::{Tonemap, MAX_EXPOSURE};
@@ -372,6 +372,8 @@ impl State {
             tonemap: keep(render.tonemap, s.tonemap, Tonemap::default()),
             // The viewer writes no AOVs; the look keeps its list for renders.
             aovs: render.aovs.clone(),
+            noise_threshold: s.noise.map(|n| n.threshold),
+            min_spp: s.noise.and_then(|n| keep(render.min_spp, n.min_samples, DEFAULT_MIN_SPP.min(s.spp).max(2))),
         };
         self.look.model = keep(saved.model, s.model, Model::default());
     }

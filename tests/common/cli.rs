@@ -102,3 +102,18 @@ pub fn lookdev_measured(dir: &std::path::Path, args: &[&str], limit: f64, max_mi
     let output = Output { status, stdout: stdout.join().unwrap(), stderr: stderr.join().unwrap() };
     Measured { output, peak_mib: peak_kib as f64 / 1024.0, seconds: start.elapsed().as_secs_f64() }
 }
+
+/// The linear radiance of an EXR lookdev wrote, as bits, row by row: for comparing images
+/// whose files differ in their metadata.
+pub fn exr_bits(path: &std::path::Path) -> Vec<[u32; 4]> {
+    use exr::prelude::{read_first_rgba_layer_from_file, RgbaChannels};
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |resolution, _: &RgbaChannels| (resolution.width(), vec![[0u32; 4]; resolution.width() * resolution.height()]),
+        |(width, pixels), position, (r, g, b, a): (f32, f32, f32, f32)| {
+            pixels[position.y() * *width + position.x()] = [r, g, b, a].map(f32::to_bits);
+        },
+    )
+    .unwrap();
+    image.layer_data.channel_data.pixels.1
+}

@@ -45,18 +45,7 @@ impl Case {
     /// Linear radiance of an EXR in the case's folder (one the viewer or `lookdev render`
     /// wrote), as bits, row by row.
     pub fn exr_bits(&self, name: &str) -> Vec<[u32; 4]> {
-        use exr::prelude::{read_first_rgba_layer_from_file, RgbaChannels};
-        let image = read_first_rgba_layer_from_file(
-            self.path(name),
-            |resolution, _: &RgbaChannels| {
-                (resolution.width(), vec![[0u32; 4]; resolution.width() * resolution.height()])
-            },
-            |(width, pixels), position, (r, g, b, a): (f32, f32, f32, f32)| {
-                pixels[position.y() * *width + position.x()] = [r, g, b, a].map(f32::to_bits);
-            },
-        )
-        .unwrap();
-        image.layer_data.channel_data.pixels.1
+        super::cli::exr_bits(&self.path(name))
     }
 
     pub fn new() -> Option<Case> {
