@@ -25,7 +25,7 @@ use glam::{UVec2, Vec2, Vec3};
 use std::f64::consts::PI;
 
 /// Clusters per side of each cube face: 6·GRID² clusters.
-pub const GRID: u32 = 4;
+pub const GRID: u32 = 8;
 /// Coarse cells across and down, at most (fewer when the global grid has fewer cells).
 pub const COARSE_COLUMNS: u32 = 32;
 pub const COARSE_ROWS: u32 = 16;
@@ -122,15 +122,19 @@ fn max_cos_over(a: f64, b: f64, c: f64) -> f64 {
     (a - c).cos().max((b - c).cos())
 }
 
+/// For the azimuths φ ∈ [φa, φb]: R and θ* with max over φ of n·ω = R cos(θ − θ*) at polar
+/// angle θ, since n·ω = n_y cos θ + sin θ·ρ cos(φ − ψ), ρ = |n_xz|, ψ = atan2(n_x, −n_z).
+fn azimuth_reduction(n: [f64; 3], phi: [f64; 2]) -> (f64, f64) {
+    let rho = (n[0] * n[0] + n[2] * n[2]).sqrt();
+    let g = if rho > 0.0 { rho * max_cos_over(phi[0], phi[1], n[0].atan2(-n[2])) } else { 0.0 };
+    ((n[1] * n[1] + g * g).sqrt(), g.atan2(n[1]))
+}
+
 /// The largest n·ω over directions ω of the lat-long rectangle of azimuths φ ∈ [φa, φb] (as in
 /// [`direction`]: φ = 2π(u − ½)) and polar angles θ ∈ [θa, θb].
 pub fn max_dot_over_rectangle(n: [f64; 3], phi: [f64; 2], theta: [f64; 2]) -> f64 {
-    // n·ω = n_y cos θ + sin θ·ρ cos(φ − ψ), with ρ = |n_xz| and ψ = atan2(n_x, −n_z).
-    let rho = (n[0] * n[0] + n[2] * n[2]).sqrt();
-    let g = if rho > 0.0 { rho * max_cos_over(phi[0], phi[1], n[0].atan2(-n[2])) } else { 0.0 };
-    // n_y cos θ + g sin θ = R cos(θ − θ*), sin θ ≥ 0 on [0, π].
-    let r = (n[1] * n[1] + g * g).sqrt();
-    r * max_cos_over(theta[0], theta[1], g.atan2(n[1]))
+    let (r, theta_star) = azimuth_reduction(n, phi);
+    r * max_cos_over(theta[0], theta[1], theta_star)
 }
 
 impl Product {
@@ -174,20 +178,33 @@ impl Product {
         let cones = cluster_cones(grid);
         let mut clusters = Vec::with_capacity(cones.len());
         let mut ratio = Vec::with_capacity(cones.len() * global.len());
+        let (phis, thetas): (Vec<[f64; 2]>, Vec<[f64; 2]>) = (
+            (0..coarse_columns).map(|cc| bounds[cc as usize].0).collect(),
+            (0..coarse_rows).map(|cr| bounds[(cr * coarse_columns) as usize].1).collect(),
+        );
+        let theta_edges: Vec<[(f64, f64); 2]> =
+            thetas.iter().map(|t| [(t[0].cos(), t[0].sin()), (t[1].cos(), t[1].sin())]).collect();
         for (centre, radius) in cones {
-            let mut weights: Vec<f64> = bounds
-                .iter()
-                .zip(&global)
-                .map(|((phi, theta), g)| {
-                    let least = max_dot_over_rectangle(centre, *phi, *theta).clamp(-1.0, 1.0).acos();
-                    let angle = (least - radius).max(0.0);
-                    if angle < 0.5 * PI {
-                        g * angle.cos()
+            let (cos_r, sin_r) = (radius.cos(), radius.sin());
+            let mut weights = vec![0.0f64; global.len()];
+            for (cc, phi) in phis.iter().enumerate() {
+                let (r, theta_star) = azimuth_reduction(centre, *phi);
+                let (cos_star, sin_star) = (theta_star.cos(), theta_star.sin());
+                for (cr, theta) in thetas.iter().enumerate() {
+                    // max n·ω over the cell (see max_dot_over_rectangle), without trigonometry.
+                    let m = if (theta[0]..=theta[1]).contains(&theta_star) {
+                        r
                     } else {
-                        0.0
+                        let [(ca, sa), (cb, sb)] = theta_edges[cr];
+                        r * (ca * cos_star + sa * sin_star).max(cb * cos_star + sb * sin_star)
                     }
-                })
-                .collect();
+                    .clamp(-1.0, 1.0);
+                    // cos(max(0, acos(m) − radius)), and 0 from π/2 on.
+                    let bound = if m >= cos_r { 1.0 } else { (m * cos_r + (1.0 - m * m).sqrt() * sin_r).max(0.0) };
+                    let c = cr * coarse_columns as usize + cc;
+                    weights[c] = global[c] * bound;
+                }
+            }
             // A cluster that sees nothing the global tables sample samples as they do.
             if weights.iter().sum::<f64>() <= 0.0 {
                 weights.clone_from(&global);
@@ -367,6 +384,66 @@ mod tests {
             }
             assert!(bound >= best - 1e-12 && bound <= best + 2e-3, "{bound} vs {best}");
         }
+    }
+
+    /// Each cluster's probabilities are G(c)·cos(max(0, θmin − r)), normalised, with θmin from
+    /// the direct maximum of n·ω over the cell.
+    #[test]
+    fn cluster_tables_weigh_the_global_probability_by_the_cosine_bound() {
+        let env = sun_map();
+        let d = Distribution::compensated_with_max_cells(&env, 4096);
+        let p = Product::build(&d);
+        let cones = cluster_cones(GRID);
+        let mut fallbacks = 0;
+        for (k, (centre, radius)) in cones.iter().enumerate() {
+            let mut expected = Vec::new();
+            let mut global = Vec::new();
+            for cr in 0..p.coarse_rows {
+                for cc in 0..p.coarse_columns {
+                    let span = |i, coarse, cells, block, size| {
+                        let a = Distribution::span(coarse_start(i, coarse, cells), block, size).0;
+                        let b = Distribution::span(coarse_start(i + 1, coarse, cells), block, size).0;
+                        [a as f64 / size as f64, b as f64 / size as f64]
+                    };
+                    let x = span(cc, p.coarse_columns, p.columns, d.block_x, d.width);
+                    let y = span(cr, p.coarse_rows, p.rows, d.block_y, d.height);
+                    let phi = [2.0 * PI * (x[0] - 0.5), 2.0 * PI * (x[1] - 0.5)];
+                    let least = max_dot_over_rectangle(*centre, phi, [PI * y[0], PI * y[1]]).clamp(-1.0, 1.0).acos();
+                    let angle = (least - radius).max(0.0);
+                    expected.push(if angle < 0.5 * PI { angle.cos() } else { 0.0 });
+                    let r0 = coarse_start(cr, p.coarse_rows, p.rows) as usize;
+                    let r1 = coarse_start(cr + 1, p.coarse_rows, p.rows) as usize;
+                    let (c0, c1) = (
+                        coarse_start(cc, p.coarse_columns, p.columns) as usize,
+                        coarse_start(cc + 1, p.coarse_columns, p.columns) as usize,
+                    );
+                    global.push(
+                        (r0..r1)
+                            .map(|r| {
+                                (d.marginal.cdf[r + 1] as f64 - d.marginal.cdf[r] as f64)
+                                    * (d.conditional[r].cdf[c1] as f64 - d.conditional[r].cdf[c0] as f64)
+                            })
+                            .sum::<f64>(),
+                    );
+                }
+            }
+            let total: f64 = expected.iter().zip(&global).map(|(b, g)| b * g).sum();
+            fallbacks += (total == 0.0) as usize;
+            for (c, (b, g)) in expected.iter().zip(&global).enumerate() {
+                if *g > 1e-6 {
+                    let got = p.ratio[k * p.coarse_cells() as usize + c] as f64;
+                    // A cluster that sees nothing sampled samples as the global tables do.
+                    let b = if total > 0.0 { *b } else { 1.0 };
+                    let total = if total > 0.0 { total } else { 1.0 };
+                    assert!(
+                        (got - b / total).abs() <= 1e-3 * (b / total) + 1e-4,
+                        "cluster {k}, cell {c}: {got} vs {}",
+                        b / total
+                    );
+                }
+            }
+        }
+        assert!(fallbacks > 0 && fallbacks < cones.len() / 2, "{fallbacks} clusters see nothing");
     }
 
     fn sun_map() -> Environment {
