@@ -239,12 +239,20 @@ vec3 env_sample_product(uint cluster, vec2 u, out uvec2 at) {
     float a = imageLoad(env_cdf, ivec2(c0, 1u + row)).x;
     float b = imageLoad(env_cdf, ivec2(c1, 1u + row)).x;
     float target = a + ux * (b - a);
-    uint found = env_search(1u + row, env_columns, target, bounds);
-    uint column = clamp(found, c0, c1 - 1u);
-    if (column != found) {
-        bounds = vec2(imageLoad(env_cdf, ivec2(column, 1u + row)).x, imageLoad(env_cdf, ivec2(column + 1u, 1u + row)).x);
+    // A plain binary search within the span: its few steps are the same for every lane, where
+    // the row's guide table may crowd a dim span into one long search.
+    uint lo = c0;
+    uint hi = c1;
+    while (hi - lo > 1u) {
+        uint mid = (lo + hi) >> 1;
+        if (imageLoad(env_cdf, ivec2(mid, 1u + row)).x <= target) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
     }
-    return env_point_in_cell(row, column, env_rescale(target, bounds), dv, at);
+    bounds = vec2(imageLoad(env_cdf, ivec2(lo, 1u + row)).x, imageLoad(env_cdf, ivec2(lo + 1u, 1u + row)).x);
+    return env_point_in_cell(row, lo, env_rescale(target, bounds), dv, at);
 }
 
 // The environment sample of product sampling: from `cluster`'s table with probability q, from

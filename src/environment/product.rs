@@ -306,8 +306,18 @@ impl Product {
         let conditional = &d.conditional[row as usize];
         let (a, b) = (conditional.cdf[c0 as usize], conditional.cdf[c1 as usize]);
         let target = a + ux * (b - a);
-        let column = (conditional.search(target) as u32).clamp(c0, c1 - 1);
-        let du = rescale(target, conditional.cdf[column as usize], conditional.cdf[column as usize + 1]);
+        // The last cell of the span whose CDF value is ≤ target, by a plain binary search.
+        let (mut lo, mut hi) = (c0 as usize, c1 as usize);
+        while hi - lo > 1 {
+            let mid = (lo + hi) / 2;
+            if conditional.cdf[mid] <= target {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let column = lo as u32;
+        let du = rescale(target, conditional.cdf[lo], conditional.cdf[lo + 1]);
         d.point_in_cell(row, column, du, dv)
     }
 }
