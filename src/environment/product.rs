@@ -456,6 +456,37 @@ mod tests {
         assert!(fallbacks > 0 && fallbacks < cones.len() / 2, "{fallbacks} clusters see nothing");
     }
 
+    /// Maps smaller than the coarse grid, and blocked cells of a map wider than the cell
+    /// limit, still give tables whose every pdf integrates to 1.
+    #[test]
+    fn tiny_and_blocked_maps_give_whole_tables() {
+        let maps = [
+            (Environment::new(2, 1, vec![[1.0; 3], [3.0; 3]], "2x1"), 4096),
+            (Environment::new(1, 1, vec![[0.5; 3]], "1x1"), 4096),
+            (Environment::new(40, 20, (0..800).map(|i| [(i % 11) as f32; 3]).collect(), "blocked"), 7),
+        ];
+        for (env, max_cells) in maps {
+            let d = Distribution::compensated_with_max_cells(&env, max_cells);
+            let p = Product::build(&d);
+            let (w, h, buckets, cdfs) = p.table_texels();
+            assert_eq!((buckets.len(), cdfs.len()), ((w * h) as usize, (w * h) as usize));
+            for cluster in 0..p.clusters.len() as u32 {
+                let mut total = 0.0;
+                for r in 0..d.rows {
+                    for c in 0..d.columns {
+                        let t = UVec2::new(c * d.block_x, r * d.block_y);
+                        total += d.texel_cell_pdf(t) as f64
+                            * p.texel_ratio(&d, cluster, t) as f64
+                            * d.cell_solid_angle(r, c);
+                    }
+                }
+                assert!((total - 1.0).abs() < 1e-4, "{}: cluster {cluster}: {total}", env.source);
+                let (dir, t) = p.sample(&d, cluster, Vec2::new(0.3, 0.7));
+                assert!(dir.is_finite() && t.x < env.width && t.y < env.height, "{}", env.source);
+            }
+        }
+    }
+
     fn sun_map() -> Environment {
         let (w, h) = (128u32, 64u32);
         let texels = (0..w * h)
