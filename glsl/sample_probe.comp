@@ -21,12 +21,13 @@ const uint ROUTINE_BRDF = 3u;
 const uint ROUTINE_ENVIRONMENT = 4u;
 const uint ROUTINE_SOBOL = 5u;
 const uint ROUTINE_UV_ROUND_TRIP = 6u;
+const uint ROUTINE_PRODUCT = 7u;  // the product mixture: cluster `seed`, share view.w
 
 layout(set = 0, binding = 0, std430) readonly buffer Setup {
     vec4 params[4];
     vec4 view;      // shading frame
     uint routine;
-    uint seed;      // for ROUTINE_SOBOL
+    uint seed;      // for ROUTINE_SOBOL; the cluster for ROUTINE_PRODUCT
 };
 layout(set = 0, binding = 1, std430) readonly buffer Uniforms {
     vec2 uniforms[];
@@ -64,6 +65,11 @@ void main() {
         vec3 d = env_sample(u, texel);
         // Also check that looking the pdf up from the direction agrees with the sampler's own.
         float looked_up = env_texel(env_direction_to_uv(d)).a;
+        result = vec4(d, abs(looked_up - texel.a) <= 1e-3 * texel.a ? texel.a : -1.0);
+    } else if (routine == ROUTINE_PRODUCT) {
+        vec4 texel;
+        vec3 d = env_sample_mixture(seed, view.w, u, texel);
+        float looked_up = env_texel_mixture(seed, view.w, env_direction_to_uv(d)).a;
         result = vec4(d, abs(looked_up - texel.a) <= 1e-3 * texel.a ? texel.a : -1.0);
     } else if (routine == ROUTINE_SOBOL) {
         result = vec4(sobol_owen_2d(i, seed), 0.0, 0.0);

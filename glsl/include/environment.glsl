@@ -28,7 +28,17 @@ layout(set = 1, binding = 3, std430) readonly buffer EnvInfo {
     uint env_block_y;
     uint env_columns;  // cells
     uint env_rows;
+    uint env_product_grid;    // product sampling: clusters per cube-face side; 0 when off
+    uint env_coarse_columns;  // coarse cells, each a block of cells
+    uint env_coarse_rows;
 };
+// Product sampling (src/environment/product.rs): the bucket entries and CDFs, laid out as
+// env_buckets and env_cdf are, of one table per cluster of normals over the coarse cells (rows
+// 0 .. clusters − 1), then one per coarse cell over its rows of cells; env_product_cdf then holds
+// one row per cluster of the ratio of its pdf to the global pdf in each coarse cell. 1×1
+// placeholders when off.
+layout(set = 1, binding = 4, rgba32f) uniform readonly image2D env_product_buckets;
+layout(set = 1, binding = 5, r32f) uniform readonly image2D env_product_cdf;
 
 // v = acos(d.y)/π, computed as atan2(|d.xz|, d.y)/π: the same angle for a unit d, but well
 // conditioned near the poles, and accurate where a driver's acos is only approximate.
@@ -50,10 +60,15 @@ vec3 env_uv_to_direction(vec2 uv) {
     return env_direction(uv.x, cos(theta), sin(theta));
 }
 
+// The coordinates of the texel holding uv.
+ivec2 env_texel_at(vec2 uv) {
+    ivec2 size = ivec2(env_width, env_height);
+    return min(ivec2(uv * vec2(size)), size - 1);
+}
+
 // The texel holding uv: its radiance (rgb) and its cell's pdf_ω (a).
 vec4 env_texel(vec2 uv) {
-    ivec2 size = ivec2(env_width, env_height);
-    return imageLoad(env_texels, min(ivec2(uv * vec2(size)), size - 1));
+    return imageLoad(env_texels, env_texel_at(uv));
 }
 
 // Bilinear radiance between texel centres, wrapping in u and clamping in v: for the background.
@@ -101,18 +116,8 @@ float env_row_cos(uint y) {
     return cos(PI * float(y) / float(env_height));
 }
 
-// Samples a direction in proportion to the distribution: a cell by the tables, then a point
-// uniform in solid angle within it (uniform in azimuth and in cos θ). Returns the direction and
-// its texel: radiance and pdf_ω.
-vec3 env_sample(vec2 u, out vec4 texel) {
-    vec2 bounds;
-    uint row = env_search(0u, env_rows, u.y, bounds);
-    float dv = bounds.y > bounds.x ? (u.y - bounds.x) / (bounds.y - bounds.x) : 0.5;
-    uint column = env_search(1u + row, env_columns, u.x, bounds);
-    float du = bounds.y > bounds.x ? (u.x - bounds.x) / (bounds.y - bounds.x) : 0.5;
-    du = min(du, ONE_MINUS_EPSILON);
-    dv = min(dv, ONE_MINUS_EPSILON);
-
+// The point at (du, dv) of cell (row, column), uniform in azimuth and in cos θ, and its texel.
+vec3 env_point_in_cell(uint row, uint column, float du, float dv, out uvec2 at) {
     uvec2 start = uvec2(column * env_block_x, row * env_block_y);
     uvec2 end = min(start + uvec2(env_block_x, env_block_y), uvec2(env_width, env_height));
     float x = float(start.x) + du * float(end.x - start.x);
@@ -121,8 +126,157 @@ vec3 env_sample(vec2 u, out vec4 texel) {
     // With one texel row per cell the row is known; otherwise find it from the angle.
     uint y = env_block_y == 1u ? start.y
                                : clamp(uint(atan(sin_theta, z) * INV_PI * float(env_height)), start.y, end.y - 1u);
-    texel = imageLoad(env_texels, ivec2(min(uint(x), end.x - 1u), y));
+    at = uvec2(min(uint(x), end.x - 1u), y);
     return env_direction(x / float(env_width), z, sin_theta);
+}
+
+// Samples a direction in proportion to the distribution: a cell by the tables, then a point
+// uniform in solid angle within it (uniform in azimuth and in cos θ). Returns the direction and
+// its texel's coordinates.
+vec3 env_sample_at(vec2 u, out uvec2 at) {
+    vec2 bounds;
+    uint row = env_search(0u, env_rows, u.y, bounds);
+    float dv = bounds.y > bounds.x ? (u.y - bounds.x) / (bounds.y - bounds.x) : 0.5;
+    uint column = env_search(1u + row, env_columns, u.x, bounds);
+    float du = bounds.y > bounds.x ? (u.x - bounds.x) / (bounds.y - bounds.x) : 0.5;
+    du = min(du, ONE_MINUS_EPSILON);
+    dv = min(dv, ONE_MINUS_EPSILON);
+    return env_point_in_cell(row, column, du, dv, at);
+}
+
+// As env_sample_at, returning the texel: radiance and pdf_ω.
+vec3 env_sample(vec2 u, out vec4 texel) {
+    uvec2 at;
+    vec3 d = env_sample_at(u, at);
+    texel = imageLoad(env_texels, ivec2(at));
+    return d;
+}
+
+// The cluster of the unit normal n (environment space): the face of its largest axis, then a
+// cell of env_product_grid² on that face. Mirrors product::cluster_of.
+uint env_cluster(vec3 n) {
+    vec3 a = abs(n);
+    uint face;
+    vec2 p;
+    if (a.x >= a.y && a.x >= a.z) {
+        face = n.x > 0.0 ? 0u : 1u;
+        p = n.yz / a.x;
+    } else if (a.y >= a.z) {
+        face = n.y > 0.0 ? 2u : 3u;
+        p = n.xz / a.y;
+    } else {
+        face = n.z > 0.0 ? 4u : 5u;
+        p = n.xy / a.z;
+    }
+    uint grid = env_product_grid;
+    uvec2 cell = min(uvec2((p * 0.5 + 0.5) * float(grid)), uvec2(grid - 1u));
+    return (face * grid + cell.y) * grid + cell.x;
+}
+
+// The first cell of coarse cell i of `coarse` along an axis of `cells` cells.
+uint env_coarse_start(uint i, uint coarse, uint cells) {
+    return i * cells / coarse;
+}
+
+// The product tables' rows: the clusters' tables, then the coarse cells', then the ratios.
+uint env_clusters() {
+    return 6u * env_product_grid * env_product_grid;
+}
+
+// The ratio of `cluster`'s product pdf to the global pdf at texel `at`.
+float env_product_ratio(uint cluster, uvec2 at) {
+    uint cc = ((at.x / env_block_x + 1u) * env_coarse_columns - 1u) / env_columns;
+    uint cr = ((at.y / env_block_y + 1u) * env_coarse_rows - 1u) / env_rows;
+    uint cells = env_coarse_columns * env_coarse_rows;
+    return imageLoad(env_product_cdf, ivec2(cr * env_coarse_columns + cc, env_clusters() + cells + cluster)).x;
+}
+
+// env_search on the product tables.
+uint env_product_search(uint table, uint n, float u, out vec2 bounds) {
+    uint k = min(uint(u * float(n)), n - 1u);
+    vec4 entry = imageLoad(env_product_buckets, ivec2(k, table));
+    uint lo = uint(entry.z);
+    uint hi = uint(entry.w) + 1u;
+    bounds = entry.xy;
+    if (hi - lo > 1u) {
+        while (hi - lo > 1u) {
+            uint mid = (lo + hi) >> 1;
+            if (imageLoad(env_product_cdf, ivec2(mid, table)).x <= u) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        bounds = vec2(imageLoad(env_product_cdf, ivec2(lo, table)).x,
+                      imageLoad(env_product_cdf, ivec2(lo + 1u, table)).x);
+    }
+    return lo;
+}
+
+// Where u lies in the interval bounds, in [0, 1); ½ for an empty interval.
+float env_rescale(float u, vec2 bounds) {
+    float t = bounds.y > bounds.x ? (u - bounds.x) / (bounds.y - bounds.x) : 0.5;
+    return clamp(t, 0.0, ONE_MINUS_EPSILON);
+}
+
+// Samples `cluster`'s product distribution: a coarse cell by its table (u.x), a row of cells in
+// it by the coarse cell's table (u.y), a cell of that row by the global conditional table within
+// the coarse cell's span (u.x rescaled), and a point in the cell. Mirrors Product::sample.
+vec3 env_sample_product(uint cluster, vec2 u, out uvec2 at) {
+    vec2 bounds;
+    uint cells = env_coarse_columns * env_coarse_rows;
+    uint c = env_product_search(cluster, cells, u.x, bounds);
+    float ux = env_rescale(u.x, bounds);
+    uint cr = c / env_coarse_columns;
+    uint cc = c % env_coarse_columns;
+    uint r0 = env_coarse_start(cr, env_coarse_rows, env_rows);
+    uint r1 = env_coarse_start(cr + 1u, env_coarse_rows, env_rows);
+    uint c0 = env_coarse_start(cc, env_coarse_columns, env_columns);
+    uint c1 = env_coarse_start(cc + 1u, env_coarse_columns, env_columns);
+    uint k = env_product_search(env_clusters() + c, r1 - r0, u.y, bounds);
+    float dv = env_rescale(u.y, bounds);
+    uint row = r0 + k;
+    float a = imageLoad(env_cdf, ivec2(c0, 1u + row)).x;
+    float b = imageLoad(env_cdf, ivec2(c1, 1u + row)).x;
+    float target = a + ux * (b - a);
+    // A plain binary search within the span: its few steps are the same for every lane, where
+    // the row's guide table may crowd a dim span into one long search.
+    uint lo = c0;
+    uint hi = c1;
+    while (hi - lo > 1u) {
+        uint mid = (lo + hi) >> 1;
+        if (imageLoad(env_cdf, ivec2(mid, 1u + row)).x <= target) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    bounds = vec2(imageLoad(env_cdf, ivec2(lo, 1u + row)).x, imageLoad(env_cdf, ivec2(lo + 1u, 1u + row)).x);
+    return env_point_in_cell(row, lo, env_rescale(target, bounds), dv, at);
+}
+
+// The environment sample of product sampling: from `cluster`'s table with probability q, from
+// the global tables otherwise, u.x choosing and then reused, rescaled. texel.a is the mixture's
+// pdf_ω.
+vec3 env_sample_mixture(uint cluster, float q, vec2 u, out vec4 texel) {
+    uvec2 at;
+    vec3 d;
+    if (u.x < q) {
+        d = env_sample_product(cluster, vec2(min(u.x / q, ONE_MINUS_EPSILON), u.y), at);
+    } else {
+        d = env_sample_at(vec2(min((u.x - q) / (1.0 - q), ONE_MINUS_EPSILON), u.y), at);
+    }
+    texel = imageLoad(env_texels, ivec2(at));
+    texel.a *= (1.0 - q) + q * env_product_ratio(cluster, at);
+    return d;
+}
+
+// The texel at uv with the mixture's pdf_ω in a.
+vec4 env_texel_mixture(uint cluster, float q, vec2 uv) {
+    ivec2 at = env_texel_at(uv);
+    vec4 texel = imageLoad(env_texels, at);
+    texel.a *= (1.0 - q) + q * env_product_ratio(cluster, uvec2(at));
+    return texel;
 }
 
 #endif

@@ -65,7 +65,7 @@ pub fn bucket(u: f32, n: u32) -> u32 {
 }
 
 impl Table {
-    fn new(weights: &[f64]) -> Table {
+    pub(crate) fn new(weights: &[f64]) -> Table {
         let cdf = cdf(weights);
         let n = weights.len() as u32;
         let guide = (0..=n)

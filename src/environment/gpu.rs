@@ -1,5 +1,6 @@
 //! The environment on the GPU: descriptor set 1 of every kernel that lights or samples.
 
+use super::product::Product;
 use super::{Distribution, Environment};
 use crate::gpu::{Binding, BindingKind, Buffer, Context, Image};
 use crate::{Error, Result};
@@ -12,10 +13,23 @@ pub struct GpuEnvironment {
     pub buckets: Image,
     pub cdf: Image,
     pub info: Buffer,
+    /// The product tables (`env_product_buckets`, `env_product_cdf`), or 1×1 placeholders.
+    pub product_buckets: Image,
+    pub product_cdf: Image,
 }
 
 impl GpuEnvironment {
     pub fn upload(ctx: &Context, env: &Environment, distribution: &Distribution) -> Result<GpuEnvironment> {
+        GpuEnvironment::upload_with(ctx, env, distribution, None)
+    }
+
+    /// As [`GpuEnvironment::upload`], with product tables built from `distribution` when given.
+    pub fn upload_with(
+        ctx: &Context,
+        env: &Environment,
+        distribution: &Distribution,
+        product: Option<&Product>,
+    ) -> Result<GpuEnvironment> {
         let max = ctx.info().max_image_dimension_2d;
         if env.width > max || env.height > max {
             return Err(Error::input_file(
@@ -32,21 +46,48 @@ impl GpuEnvironment {
         buckets.upload(ctx, bytemuck::cast_slice(&bucket_texels))?;
         let cdf = Image::new(ctx, vk::Format::R32_SFLOAT, width, height, 1, false)?;
         cdf.upload(ctx, bytemuck::cast_slice(&cdf_texels))?;
-        let info = Buffer::with_data(ctx, bytemuck::cast_slice(&distribution.header()))?;
-        Ok(GpuEnvironment { texels, buckets, cdf, info })
+        let (width, height, bucket_texels, cdf_texels) = match product {
+            Some(p) => p.table_texels(),
+            None => (1, 1, vec![[0.0; 4]], vec![0.0]),
+        };
+        if width > max || height > max {
+            return Err(Error::input_file(
+                &env.source,
+                format!("its product tables need {width}x{height} images, larger than this device's {max} pixel limit"),
+            ));
+        }
+        let product_buckets = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 1, false)?;
+        product_buckets.upload(ctx, bytemuck::cast_slice(&bucket_texels))?;
+        let product_cdf = Image::new(ctx, vk::Format::R32_SFLOAT, width, height, 1, false)?;
+        product_cdf.upload(ctx, bytemuck::cast_slice(&cdf_texels))?;
+        let mut header = [0u32; 12];
+        header[..8].copy_from_slice(&distribution.header());
+        if let Some(p) = product {
+            header[6..9].copy_from_slice(&[p.grid, p.coarse_columns, p.coarse_rows]);
+        }
+        let info = Buffer::with_data(ctx, bytemuck::cast_slice(&header))?;
+        Ok(GpuEnvironment { texels, buckets, cdf, info, product_buckets, product_cdf })
     }
 
     /// The bindings of descriptor set 1, in `environment.glsl` order.
-    pub fn bindings(&self) -> [Binding<'_>; 4] {
+    pub fn bindings(&self) -> [Binding<'_>; 6] {
         [
             Binding::Image(&self.texels),
             Binding::Image(&self.buckets),
             Binding::Image(&self.cdf),
             Binding::Buffer(&self.info),
+            Binding::Image(&self.product_buckets),
+            Binding::Image(&self.product_cdf),
         ]
     }
 }
 
 /// The layout of descriptor set 1.
-pub const SET_LAYOUT: [BindingKind; 4] =
-    [BindingKind::StorageImage, BindingKind::StorageImage, BindingKind::StorageImage, BindingKind::StorageBuffer];
+pub const SET_LAYOUT: [BindingKind; 6] = [
+    BindingKind::StorageImage,
+    BindingKind::StorageImage,
+    BindingKind::StorageImage,
+    BindingKind::StorageBuffer,
+    BindingKind::StorageImage,
+    BindingKind::StorageImage,
+];

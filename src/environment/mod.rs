@@ -12,6 +12,7 @@ pub mod distribution;
 pub mod gpu;
 pub mod library;
 pub mod load;
+pub mod product;
 pub mod sampling;
 
 pub use builtin::{Builtin, EnvironmentRef};

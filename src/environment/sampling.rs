@@ -76,9 +76,13 @@ impl Distribution {
         let column = table.search(u.x);
         let (c0, c1) = (table.cdf[column], table.cdf[column + 1]);
         let du = if c1 > c0 { (u.x - c0) / (c1 - c0) } else { 0.5 };
-        let (du, dv) = (du.min(ONE_MINUS_EPSILON), dv.min(ONE_MINUS_EPSILON));
+        self.point_in_cell(row as u32, column as u32, du.min(ONE_MINUS_EPSILON), dv.min(ONE_MINUS_EPSILON))
+    }
 
-        let start = UVec2::new(column as u32 * self.block_x, row as u32 * self.block_y);
+    /// The point at (du, dv) ∈ [0, 1)² of cell (row, column), uniform in azimuth and in cos θ,
+    /// and its texel, as `env_point_in_cell` computes them.
+    pub fn point_in_cell(&self, row: u32, column: u32, du: f32, dv: f32) -> (Vec3, UVec2) {
+        let start = UVec2::new(column * self.block_x, row * self.block_y);
         let end = (start + UVec2::new(self.block_x, self.block_y)).min(UVec2::new(self.width, self.height));
         let x = start.x as f32 + du * (end.x - start.x) as f32;
         let (z0, z1) = (row_cos(start.y, self.height) as f32, row_cos(end.y, self.height) as f32);

@@ -745,7 +745,7 @@ impl Renderer {
 /// An environment with the sampling tables `sampling` uses, on the GPU.
 fn upload_environment(ctx: &Context, environment: &Environment, sampling: Sampling) -> Result<GpuEnvironment> {
     let distribution = sampling.distribution(environment, ctx.info().max_image_dimension_2d);
-    GpuEnvironment::upload(ctx, environment, &distribution)
+    GpuEnvironment::upload_with(ctx, environment, &distribution, sampling.product(&distribution).as_ref())
 }
 
 /// Pixels restarted alone, catching up with their rows.

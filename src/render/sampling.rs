@@ -18,16 +18,21 @@ pub enum Sampling {
     /// sample covers the dim part of the sphere.
     #[default]
     Compensated,
+    /// As `Compensated`, with the environment sample drawn from tables per cluster of shading
+    /// normals, proportional to the compensated weight times a bound on the clamped cosine
+    /// ([`crate::environment::product`]): no sample is spent below the pixel's horizon.
+    Product,
 }
 
 impl Sampling {
     /// Every strategy, in the order the benchmark measures them.
-    pub const ALL: [Sampling; 2] = [Sampling::Plain, Sampling::Compensated];
+    pub const ALL: [Sampling; 3] = [Sampling::Plain, Sampling::Compensated, Sampling::Product];
 
     pub fn name(self) -> &'static str {
         match self {
             Sampling::Plain => "plain",
             Sampling::Compensated => "compensated",
+            Sampling::Product => "product",
         }
     }
 
@@ -41,13 +46,21 @@ impl Sampling {
 
     /// Whether the environment's tables are the MIS-compensated ones.
     pub fn compensated(self) -> bool {
-        matches!(self, Sampling::Compensated)
+        matches!(self, Sampling::Compensated | Sampling::Product)
     }
 
     /// The tables this estimator samples `env` by, on a device whose images are at most
     /// `max_image_side` texels a side (from the cache of tables when it holds them).
     pub fn distribution(self, env: &Environment, max_image_side: u32) -> Distribution {
         crate::environment::cache::distribution(env, max_image_side, self.compensated())
+    }
+
+    /// The product tables this estimator samples by, built from its `distribution`, if any.
+    pub fn product(self, distribution: &Distribution) -> Option<crate::environment::product::Product> {
+        matches!(self, Sampling::Product).then(|| {
+            let _timing = crate::timings::phase("product tables");
+            crate::environment::product::Product::build(distribution)
+        })
     }
 }
 
@@ -67,6 +80,6 @@ mod tests {
             assert_eq!(Sampling::parse(s.name()), Ok(s));
         }
         let err = Sampling::parse("best").unwrap_err();
-        assert!(err.contains("'best'") && err.contains("plain, compensated"), "{err}");
+        assert!(err.contains("'best'") && err.contains("plain, compensated, product"), "{err}");
     }
 }
