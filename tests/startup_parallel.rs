@@ -1,7 +1,8 @@
 //! The overlapped start-up (`lookdev::render::startup`): the kernels compiled on the device
 //! thread while the scene loads give the image a serial start-up gives, bit for bit; a failure
 //! on either side ends the process with one clear error and a non-zero exit, never a hang or a
-//! panic, and a bad scene is still reported before a device that failed.
+//! panic, and a bad scene is still reported before a device that failed. An environment file's
+//! decoded texels come from the cache the second time, by content, and give the same image.
 
 mod common;
 
@@ -81,12 +82,13 @@ fn the_overlapped_start_up_renders_what_a_serial_one_renders() {
 }
 
 /// Runs `lookdev render` of the built-in ball at 64², 1 spp, to `dir/out.exr`, with validation
-/// on, `extra` arguments and `LOOKDEV_FAIL_AT=fail_at` if given; fails if it runs a minute.
+/// and timings on, `dir/cache` the cache folder, `extra` arguments and `LOOKDEV_FAIL_AT=fail_at` if given; fails if it runs a minute.
 fn render_cli(dir: &Path, fail_at: Option<&str>, extra: &[&str]) -> Output {
     let out = dir.join("out.exr");
     let mut command = Command::new(env!("CARGO_BIN_EXE_lookdev"));
     command.args(["render", "--size", "64", "64", "--spp", "1", "--quiet", "--out", out.to_str().unwrap()]);
-    command.args(extra).env("LOOKDEV_VALIDATION", "1").env("XDG_CACHE_HOME", dir.join("cache"));
+    command.args(extra).env("LOOKDEV_VALIDATION", "1").env("LOOKDEV_TIMINGS", "1");
+    command.env("XDG_CACHE_HOME", dir.join("cache"));
     match fail_at {
         Some(step) => command.env("LOOKDEV_FAIL_AT", step),
         None => command.env_remove("LOOKDEV_FAIL_AT"),
@@ -145,16 +147,65 @@ fn a_device_that_fails_to_open_fails_the_render_cleanly() {
 fn a_bad_scene_is_reported_first_whatever_the_device_thread_does() {
     let dir = tempfile::tempdir().unwrap();
     let look = dir.path().join("missing.toml");
-    // Before the settings are known: the device thread is never asked to compile.
+    // The look: the settings are never known.
     for fail_at in [None, Some("device"), Some("pipeline")] {
         let output = render_cli(dir.path(), fail_at, &["--look", look.to_str().unwrap()]);
         assert_fails(&output, dir.path(), 2, &["missing.toml"]);
     }
-    // After them (a g-buffer that is not an EXR): the kernels compile, or fail to, meanwhile.
+    // The g-buffer, read after the look and the environment.
     let gbuffer = dir.path().join("garbage.exr");
     std::fs::write(&gbuffer, b"not an image at all").unwrap();
     for fail_at in [None, Some("device"), Some("pipeline")] {
         let output = render_cli(dir.path(), fail_at, &["--gbuffer", gbuffer.to_str().unwrap()]);
         assert_fails(&output, dir.path(), 2, &["garbage.exr"]);
     }
+}
+
+/// Every channel of an EXR's layers, as bits (its header names the map, which may differ).
+fn pixels(path: &Path) -> Vec<Vec<u32>> {
+    use exr::prelude::*;
+    let image = read_all_flat_layers_from_file(path).unwrap();
+    let layers = image.layer_data.iter().flat_map(|layer| &layer.channel_data.list);
+    layers.map(|channel| channel.sample_data.values_as_f32().map(f32::to_bits).collect()).collect()
+}
+
+#[test]
+fn an_environment_files_decoded_texels_are_cached_by_content() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = dir.path().join("a.exr");
+    std::fs::copy(concat!(env!("CARGO_MANIFEST_DIR"), "/src/environment/studio.exr"), &map).unwrap();
+    let render = |map: &Path| {
+        let output = render_cli(dir.path(), None, &["--env", map.to_str().unwrap(), "--env-clamp"]);
+        assert!(output.status.success(), "{}", stderr(&output));
+        let text = stderr(&output);
+        // The checks run on cached texels as on decoded ones: the clamp's warning each time.
+        assert!(text.contains("clamped 0 NaN, 0 infinite and 3 negative texels"), "{text}");
+        (text, pixels(&dir.path().join("out.exr")))
+    };
+    let loaded = |text: &str| text.contains(".exr loaded from") && text.contains(".texels");
+    let stored = |text: &str| text.lines().any(|l| l.contains("cache: wrote") && l.contains("file-"));
+    let (cold, image) = render(&map);
+    assert!(!loaded(&cold) && stored(&cold), "{cold}");
+    let (warm, warm_image) = render(&map);
+    assert!(loaded(&warm) && !stored(&warm), "{warm}");
+    assert!(warm_image == image, "the cached texels render another image");
+    // The same bytes under another name: the same entry.
+    let copy = dir.path().join("b.exr");
+    std::fs::copy(&map, &copy).unwrap();
+    let (text, copy_image) = render(&copy);
+    assert!(loaded(&text) && !stored(&text), "{text}");
+    assert!(copy_image == image);
+    // A damaged entry is decoded again, with the same image, and rewritten.
+    let entries: Vec<_> = std::fs::read_dir(dir.path().join("cache/lookdev/environments"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.file_name().unwrap().to_string_lossy().starts_with("file-"))
+        .collect();
+    assert_eq!(entries.len(), 1, "{entries:?}");
+    let bytes = std::fs::read(&entries[0]).unwrap();
+    std::fs::write(&entries[0], &bytes[..bytes.len() / 2]).unwrap();
+    let (text, repaired) = render(&map);
+    assert!(!loaded(&text) && stored(&text), "{text}");
+    assert!(repaired == image);
+    assert_eq!(std::fs::read(&entries[0]).unwrap(), bytes, "rewritten whole");
 }

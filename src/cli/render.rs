@@ -135,7 +135,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
         return run_compare(&args, format, second.as_deref(), &spec);
     }
     let display = args.aov_display.as_deref().map(|name| display_aov(name, format)).transpose()?;
-    // The device opens and the kernels compile while the scene loads (crate::render::startup).
+    // The device opens while the scene loads, and the kernels compile while the scene uploads
+    // (crate::render::startup).
     let options = ContextOptions::from_env(args.device.clone());
     let (scene, rendered, device_name) = std::thread::scope(|threads| -> Result<_> {
         let specialize = |settings: &Settings| kernels_for(settings, &output_aovs(format, display, settings));

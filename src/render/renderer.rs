@@ -797,8 +797,8 @@ fn kernel_accumulate(wanted: Accumulate, noise: Option<NoiseThreshold>) -> Accum
 }
 
 /// What the renderer's kernels are specialised for: the BRDF model and what the relight kernel
-/// accumulates. A scene's settings and the AOVs a command writes give it, before the g-buffer
-/// and environment are read, so the kernels can compile while those load.
+/// accumulates. A scene's settings and the AOVs a command writes give it, so the kernels can
+/// compile while the scene uploads.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Specialization {
     pub model: Model,

@@ -56,22 +56,9 @@ pub struct Scene {
     pub stacks: PackedStacks,
 }
 
-/// A scene's first, quick stage: its look, prepared, and the settings it resolves to. What
-/// specialises the renderer's kernels is known from here, before the g-buffer and the
-/// environment are read ([`crate::render::startup`]).
-pub struct SceneStart {
-    look: Look,
-    pub settings: Settings,
-}
-
 impl Scene {
     /// Reads and checks everything `spec` names, printing the warnings; see [`SceneSpec`].
     pub fn load(spec: &SceneSpec) -> Result<Scene> {
-        Scene::start(spec)?.finish(spec)
-    }
-
-    /// The first stage of [`Scene::load`]: the look and the settings.
-    pub fn start(spec: &SceneSpec) -> Result<SceneStart> {
         let mut look = match &spec.look {
             LookSource::File(path) => Look::load(path)?,
             LookSource::Given(look) => (**look).clone(),
@@ -80,7 +67,16 @@ impl Scene {
         };
         prepare_look(&mut look, &spec.sets)?;
         let settings = Settings::resolve(&look, &spec.overrides)?;
-        Ok(SceneStart { look, settings })
+        let environment = load_environment(settings.environment.as_ref(), &spec.env_options)?;
+        let ReadGBuffer { gbuffer, name: gbuffer_name, claims } = read_gbuffer(&spec.gbuffer, &mut look, spec.quiet)?;
+        claims.into_iter().for_each(crate::warn);
+        let covered = covered_object_ids(&gbuffer);
+        let stacks = PackedStacks::pack(&look, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
+        look_warnings(&look, &covered, &gbuffer_name).into_iter().for_each(crate::warn);
+        dark_render_warnings(&gbuffer, &gbuffer_name, &environment, settings.lighting.intensity)
+            .into_iter()
+            .for_each(crate::warn);
+        Ok(Scene { gbuffer, gbuffer_name, look, environment, settings, stacks })
     }
 
     /// Whether this device can hold the g-buffer: checked once the device is known, and
@@ -103,23 +99,6 @@ impl Scene {
             )));
         }
         Ok(())
-    }
-}
-
-impl SceneStart {
-    /// The rest of [`Scene::load`]: the environment, the g-buffer and the packed stacks.
-    pub fn finish(self, spec: &SceneSpec) -> Result<Scene> {
-        let SceneStart { mut look, settings } = self;
-        let environment = load_environment(settings.environment.as_ref(), &spec.env_options)?;
-        let ReadGBuffer { gbuffer, name: gbuffer_name, claims } = read_gbuffer(&spec.gbuffer, &mut look, spec.quiet)?;
-        claims.into_iter().for_each(crate::warn);
-        let covered = covered_object_ids(&gbuffer);
-        let stacks = PackedStacks::pack(&look, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
-        look_warnings(&look, &covered, &gbuffer_name).into_iter().for_each(crate::warn);
-        dark_render_warnings(&gbuffer, &gbuffer_name, &environment, settings.lighting.intensity)
-            .into_iter()
-            .for_each(crate::warn);
-        Ok(Scene { gbuffer, gbuffer_name, look, environment, settings, stacks })
     }
 }
 
