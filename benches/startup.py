@@ -48,7 +48,7 @@ def main():
         folder = Path(folder)
         sphere, look = folder / "sphere.exr", folder / "metal.toml"
         look.write_text(METAL)
-        subprocess.run([binaries[0], "gbuffer", "--builtin", "sphere", "--size", "256", "256", "--out", str(sphere)], check=True)
+        subprocess.run([binaries[-1], "gbuffer", "--builtin", "sphere", "--size", "256", "256", "--out", str(sphere)], check=True)
         env = str(REPO / "src/environment/studio.exr")
         cases = {
             "1 spp": ["render", "--size", "256", "256", "--spp", "1", "--quiet"],
