@@ -8,13 +8,15 @@ mod common;
 
 use common::cli::stderr;
 use lookdev::gpu::ContextOptions;
-use lookdev::render::progressive;
+use lookdev::render::batch::Batch;
 use lookdev::render::renderer::{Accumulate, KernelSource, Specialization};
 use lookdev::render::sampling::Sampling;
 use lookdev::render::scene::{GBufferSpec, Scene, SceneSpec};
 use lookdev::render::settings::Overrides;
+use lookdev::render::settings::Settings;
 use lookdev::render::startup::{self, Started};
 use lookdev::render::Renderer;
+use lookdev::render::{aov, progressive};
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -79,6 +81,49 @@ fn the_overlapped_start_up_renders_what_a_serial_one_renders() {
     assert!(threaded.0 == serial.0, "the radiance differs");
     assert!(threaded.1 == serial.1, "the display pixels differ");
     assert!(serial.0.iter().any(|&bits| f32::from_bits(bits) > 0.0), "a black render proves nothing");
+}
+
+#[test]
+fn a_batch_started_overlapped_renders_what_a_serial_one_renders() {
+    // As `lookdev turntable` starts: kernels for the settings' AOVs, compiled while the scene
+    // uploads; then two frames, the second turned.
+    let mut spec = spec();
+    spec.overrides.aovs = vec!["diffuse".into(), "variance".into()];
+    let frames = |batch: &mut Batch, scene: &Scene| -> Vec<Vec<u32>> {
+        let mut settings = scene.settings.clone();
+        (0..2)
+            .map(|frame| {
+                settings.lighting.rotation_degrees = 90.0 * frame as f32;
+                batch.render(&scene.look, &settings, |_| {}).unwrap();
+                let mut bits: Vec<u32> = batch.radiance().unwrap().iter().flatten().map(|v| v.to_bits()).collect();
+                for layer in batch.aovs(&scene.look, &settings).unwrap() {
+                    bits.extend(layer.channels.iter().flat_map(|(_, values)| values.iter().map(|v| v.to_bits())));
+                }
+                bits
+            })
+            .collect()
+    };
+    let options =
+        ContextOptions { validation: true, ..ContextOptions::from_env(std::env::var("LOOKDEV_TEST_DEVICE").ok()) };
+    let threaded = std::thread::scope(|threads| {
+        let specialize = |settings: &Settings| Specialization::of_render(settings, aov::accumulate(&settings.aovs));
+        let Started { scene, ctx, kernels } = startup::start(threads, &spec, options, specialize).unwrap();
+        let (name, sampling) = (Path::new("built-in"), scene.settings.sampling);
+        let kernels = KernelSource::Pending(kernels);
+        let mut batch = Batch::with_kernels(&ctx, &scene.gbuffer, name, &scene.environment, sampling, kernels).unwrap();
+        let images = frames(&mut batch, &scene);
+        drop(batch);
+        common::gpu::finish(ctx);
+        images
+    });
+    let scene = Scene::load(&spec).unwrap();
+    let ctx = common::gpu::context();
+    let mut batch = Batch::new(&ctx, &scene.gbuffer, Path::new("built-in"), &scene.environment).unwrap();
+    let serial = frames(&mut batch, &scene);
+    drop(batch);
+    common::gpu::finish(ctx);
+    assert!(threaded == serial, "the frames differ");
+    assert!(serial[0] != serial[1], "the light turned");
 }
 
 /// Runs `lookdev render` of the built-in ball at 64², 1 spp, to `dir/out.exr`, with validation

@@ -843,6 +843,13 @@ pub enum KernelSource<'scope> {
     Pending(crate::render::startup::PendingKernels<'scope>),
 }
 
+impl Default for KernelSource<'_> {
+    /// The default model's kernels, accumulating nothing beside the total, compiled when needed.
+    fn default() -> Self {
+        KernelSource::Compile(Specialization::default())
+    }
+}
+
 impl KernelSource<'_> {
     pub fn specialization(&self) -> Specialization {
         match self {
