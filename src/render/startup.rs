@@ -3,9 +3,9 @@
 //! settings specialise while the calling thread uploads the g-buffer and the environment
 //! (its sampling tables included). On a CPU driver the relight kernel's compile is start-up's
 //! longest step, and lavapipe's pipeline cache keeps no compiled code, so the compile overlaps
-//! the uploads instead (docs/development.md, "Start-up"). A bad scene is refused before anything
-//! is compiled, in little time and memory. Pipeline creation is thread-safe, and the pipeline
-//! cache synchronises itself.
+//! the uploads instead (docs/development.md, "Start-up"). A bad scene is refused before
+//! anything is compiled, in little time and memory. Pipeline creation is thread-safe, and the
+//! pipeline cache synchronises itself.
 
 use crate::gpu::{Context, ContextOptions};
 use crate::render::renderer::{Kernels, Specialization};
