@@ -126,12 +126,16 @@ fn a_batch_started_overlapped_renders_what_a_serial_one_renders() {
     assert!(serial[0] != serial[1], "the light turned");
 }
 
-/// Runs `lookdev render` of the built-in ball at 64², 1 spp, to `dir/out.exr`, with validation
-/// and timings on, `dir/cache` the cache folder, `extra` arguments and `LOOKDEV_FAIL_AT=fail_at` if given; fails if it runs a minute.
+/// Runs `lookdev render` of the built-in ball at 64², 1 spp unless `extra` says, to
+/// `dir/out.exr`, with validation and timings on, `dir/cache` the cache folder, `extra`
+/// arguments and `LOOKDEV_FAIL_AT=fail_at` if given; fails if it runs a minute.
 fn render_cli(dir: &Path, fail_at: Option<&str>, extra: &[&str]) -> Output {
     let out = dir.join("out.exr");
     let mut command = Command::new(env!("CARGO_BIN_EXE_lookdev"));
-    command.args(["render", "--size", "64", "64", "--spp", "1", "--quiet", "--out", out.to_str().unwrap()]);
+    command.args(["render", "--size", "64", "64", "--quiet", "--out", out.to_str().unwrap()]);
+    if !extra.contains(&"--spp") {
+        command.args(["--spp", "1"]);
+    }
     command.args(extra).env("LOOKDEV_VALIDATION", "1").env("LOOKDEV_TIMINGS", "1");
     command.env("XDG_CACHE_HOME", dir.join("cache"));
     match fail_at {
@@ -253,4 +257,23 @@ fn an_environment_files_decoded_texels_are_cached_by_content() {
     assert!(!loaded(&text) && stored(&text), "{text}");
     assert!(repaired == image);
     assert_eq!(std::fs::read(&entries[0]).unwrap(), bytes, "rewritten whole");
+}
+
+#[test]
+fn each_kernel_and_the_environment_are_made_once() {
+    // The renderer is made with the settings' specialisation and estimator, so the options that
+    // change them cost no second compile or upload (the timings name each compile and each
+    // look-up of the tables).
+    let dir = tempfile::tempdir().unwrap();
+    let count = |extra: &[&str], what: &str| {
+        let output = render_cli(dir.path(), None, extra);
+        assert!(output.status.success(), "{}", stderr(&output));
+        stderr(&output).lines().filter(|l| l.starts_with(&format!("lookdev: timing: {what} "))).count()
+    };
+    let threshold = ["--noise-threshold", "0.1", "--min-spp", "2", "--spp", "4"];
+    for extra in [&threshold[..], &["--aov", "all"], &["--model", "diffuse=oren-nayar"]] {
+        assert_eq!(count(extra, "pipeline relight"), 1, "{extra:?}");
+        assert_eq!(count(extra, "pipeline resolve"), 1, "{extra:?}");
+    }
+    assert_eq!(count(&["--sampling", "plain"], "environment tables"), 1);
 }
