@@ -2,13 +2,15 @@
 
 use super::inputs::SceneArgs;
 use super::progress::Progress;
-use crate::gpu::Context;
+use crate::gpu::{Context, ContextOptions};
 use crate::render::aov::{self, Aov};
 use crate::render::compare::{self, Summary};
 use crate::render::output::{self, Metadata, OutputFormat};
 use crate::render::progressive::{self, RenderStats};
+use crate::render::renderer::{KernelSource, Specialization};
 use crate::render::scene::{LookSource, Scene, SceneSpec};
-use crate::render::settings::Overrides;
+use crate::render::settings::{Overrides, Settings};
+use crate::render::startup::{self, Started};
 use crate::render::Renderer;
 use crate::shading::model::Model;
 use crate::{Error, Result};
@@ -82,20 +84,28 @@ struct Rendered {
     stats: RenderStats,
 }
 
-/// Relights `scene` on `ctx` and reads back what the output needs, with the AOVs `aovs`.
-fn render(ctx: &Context, scene: &Scene, aovs: &[Aov], label: &str, quiet: bool) -> Result<Rendered> {
+/// Relights `scene` on `ctx` with `kernels` (specialised for the settings and `aovs`, see
+/// [`kernels_for`]) and reads back what the output needs, with the AOVs `aovs`.
+fn render(
+    ctx: &Context,
+    scene: &Scene,
+    kernels: KernelSource,
+    aovs: &[Aov],
+    label: &str,
+    quiet: bool,
+) -> Result<Rendered> {
     scene.check_device(ctx.info())?;
     let settings = &scene.settings;
     let timing = crate::timings::phase("renderer");
-    let mut renderer = Renderer::with_model(ctx, &scene.gbuffer, &scene.environment, &settings.model)?;
+    let mut renderer = Renderer::with_kernels(ctx, &scene.gbuffer, &scene.environment, settings.sampling, kernels)?;
+    // The noise threshold before the AOVs: together they give the kernels' specialisation.
+    renderer.set_noise_threshold(settings.noise)?;
     renderer.set_accumulate(aov::accumulate(aovs))?;
     renderer.set_stacks(&scene.stacks)?;
     renderer.set_lighting(settings.lighting);
     renderer.set_seed(settings.seed);
-    renderer.set_sampling(settings.sampling, &scene.environment)?;
     drop(timing);
     let timing = crate::timings::phase("render");
-    renderer.set_noise_threshold(settings.noise)?;
     let mut progress = Progress::new(settings.spp as u64, label, quiet);
     let stats = progressive::accumulate(&mut renderer, settings.spp, |done| progress.update(done as u64))?;
     progress.finish();
@@ -124,32 +134,22 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if let Some(second) = &args.compare {
         return run_compare(&args, format, second.as_deref(), &spec);
     }
-    // The device is opened while the scene loads: neither needs the other, and on a CPU driver
-    // both take a while. A bad scene is still reported first.
-    let (scene, ctx) = std::thread::scope(|threads| {
-        let opening = threads.spawn(|| super::context(args.device.clone()));
-        let scene = {
-            let _timing = crate::timings::phase("scene");
-            Scene::load(&spec)
-        };
-        (scene, opening.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
-    });
-    let scene = scene?;
-    let settings = &scene.settings;
-    // The AOVs the output writes: an EXR the ones asked for, a PNG the one it shows.
     let display = args.aov_display.as_deref().map(|name| display_aov(name, format)).transpose()?;
-    let aovs = match (format, display) {
-        (OutputFormat::Exr, _) => settings.aovs.clone(),
-        (OutputFormat::Png, Some(aov)) => vec![aov],
-        (OutputFormat::Png, None) => Vec::new(),
-    };
-
-    let ctx = ctx?;
-    let counter = ctx.validation_counter();
-    let device_name = ctx.info().name.clone();
-    let rendered = render(&ctx, &scene, &aovs, "rendering", args.quiet)?;
-    drop(ctx);
-    super::check_validation(&counter)?;
+    // The device opens while the scene loads, and the kernels compile while the scene uploads
+    // (crate::render::startup).
+    let options = ContextOptions::from_env(args.device.clone());
+    let (scene, rendered, device_name) = std::thread::scope(|threads| -> Result<_> {
+        let specialize = |settings: &Settings| kernels_for(settings, &output_aovs(format, display, settings));
+        let Started { scene, ctx, kernels } = startup::start(threads, &spec, options, specialize)?;
+        let counter = ctx.validation_counter();
+        let device_name = ctx.info().name.clone();
+        let aovs = output_aovs(format, display, &scene.settings);
+        let rendered = render(&ctx, &scene, KernelSource::Pending(kernels), &aovs, "rendering", args.quiet)?;
+        drop(ctx);
+        super::check_validation(&counter)?;
+        Ok((scene, rendered, device_name))
+    })?;
+    let settings = &scene.settings;
     let _timing = crate::timings::phase("write");
     let metadata = Metadata::of_render(&scene.look, settings, &scene.environment);
     match display {
@@ -170,6 +170,20 @@ pub fn run(args: RenderArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The AOVs the output writes: an EXR the ones asked for, a PNG the one it shows.
+fn output_aovs(format: OutputFormat, display: Option<Aov>, settings: &Settings) -> Vec<Aov> {
+    match (format, display) {
+        (OutputFormat::Exr, _) => settings.aovs.clone(),
+        (OutputFormat::Png, Some(aov)) => vec![aov],
+        (OutputFormat::Png, None) => Vec::new(),
+    }
+}
+
+/// The kernels a render with `settings` writing `aovs` needs.
+fn kernels_for(settings: &Settings, aovs: &[Aov]) -> Specialization {
+    Specialization::of_render(settings, aov::accumulate(aovs))
 }
 
 /// The one AOV `--aov-display` shows in a PNG.
@@ -274,12 +288,13 @@ fn run_compare(args: &RenderArgs, format: OutputFormat, second_look: Option<&Pat
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
     let device_name = ctx.info().name.clone();
-    let first = render(&ctx, &a, &[], "rendering A", args.quiet)?;
+    let kernels = |scene: &Scene| KernelSource::Compile(kernels_for(&scene.settings, &[]));
+    let first = render(&ctx, &a, kernels(&a), &[], "rendering A", args.quiet)?;
     let second = match second_scene {
-        Second::Look(b) => render(&ctx, &b, &[], "rendering B", args.quiet)?,
+        Second::Look(b) => render(&ctx, &b, kernels(&b), &[], "rendering B", args.quiet)?,
         Second::Model(model) => {
             a.settings.model = model;
-            render(&ctx, &a, &[], "rendering B", args.quiet)?
+            render(&ctx, &a, kernels(&a), &[], "rendering B", args.quiet)?
         }
     };
     drop(ctx);

@@ -7,9 +7,14 @@
 
 use super::inputs::SceneArgs;
 use super::progress::Progress;
+use crate::gpu::{Context, ContextOptions};
+use crate::render::aov;
 use crate::render::batch::Batch;
 use crate::render::output::{self, Metadata, OutputFormat};
+use crate::render::renderer::{KernelSource, Specialization};
 use crate::render::scene::Scene;
+use crate::render::settings::Settings;
+use crate::render::startup::{self, Started};
 use crate::{Error, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -94,12 +99,33 @@ pub fn run(args: TurntableArgs) -> Result<()> {
     }
     let mut spec = args.scene.spec(args.look.as_deref(), &args.aovs, args.quiet)?;
     args.adaptive.apply(&mut spec.overrides);
-    let scene = Scene::load(&spec)?;
-    let ctx = super::context(args.device.clone())?;
-    let counter = ctx.validation_counter();
-    scene.check_device(ctx.info())?;
+    // The device opens while the scene loads, and the kernels compile while the scene uploads
+    // (crate::render::startup).
+    let options = ContextOptions::from_env(args.device.clone());
+    std::thread::scope(|threads| {
+        let specialize = |settings: &Settings| Specialization::of_render(settings, aov::accumulate(&settings.aovs));
+        let Started { scene, ctx, kernels } = startup::start(threads, &spec, options, specialize)?;
+        let counter = ctx.validation_counter();
+        scene.check_device(ctx.info())?;
+        render_frames(&args, &scene, &ctx, KernelSource::Pending(kernels), &pattern, format, (first, last))?;
+        drop(ctx);
+        super::check_validation(&counter)
+    })
+}
+
+/// Renders and writes the frames `first..=last` of `scene`.
+fn render_frames(
+    args: &TurntableArgs,
+    scene: &Scene,
+    ctx: &Context,
+    kernels: KernelSource,
+    pattern: &FramePattern,
+    format: OutputFormat,
+    (first, last): (u32, u32),
+) -> Result<()> {
     {
-        let mut batch = Batch::new(&ctx, &scene.gbuffer, Path::new(&scene.gbuffer_name), &scene.environment)?;
+        let (gbuffer_name, sampling) = (Path::new(&scene.gbuffer_name), scene.settings.sampling);
+        let mut batch = Batch::with_kernels(ctx, &scene.gbuffer, gbuffer_name, &scene.environment, sampling, kernels)?;
         let (width, height) = (batch.width(), batch.height());
         for frame in first..=last {
             let mut settings = scene.settings.clone();
@@ -127,8 +153,7 @@ pub fn run(args: TurntableArgs) -> Result<()> {
             }
         }
     }
-    drop(ctx);
-    super::check_validation(&counter)
+    Ok(())
 }
 
 #[cfg(test)]

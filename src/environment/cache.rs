@@ -273,6 +273,38 @@ fn decode_texels(bytes: &[u8]) -> Option<(u32, u32, Vec<[f32; 3]>)> {
     Some((width, height, texels.chunks_exact(12).map(|c| [float(&c[..4]), float(&c[4..8]), float(&c[8..])]).collect()))
 }
 
+const FILE_TEXELS: Entry = Entry { kind: "envfile", version: 1, max_payload: 128 << 20 };
+
+/// The texels of an environment file whose bytes are `bytes`, as `decode` reads them, before
+/// any check (the checks, and their warnings, run on them as on freshly decoded ones): from the
+/// cache when it holds them for these bytes, else decoded and stored. Reading them back costs
+/// less than decoding an EXR (docs/formats.md#caches); maps above 4096×2048 are not kept.
+pub fn file_texels(
+    bytes: &[u8],
+    name: &str,
+    decode: impl FnOnce() -> crate::Result<(u32, u32, Vec<[f32; 3]>)>,
+) -> crate::Result<(u32, u32, Vec<[f32; 3]>)> {
+    let _timing = crate::timings::phase("environment decode");
+    let mut key = cache::hash128(bytes).to_vec();
+    key.extend_from_slice(&sources_hash());
+    let path = folder().map(|f| f.join(format!("file-{}.texels", cache::hex(&cache::hash128(&key)))));
+    if let Some(texels) = path.as_deref().and_then(|path| FILE_TEXELS.load(path, &key)).and_then(|p| decode_texels(&p))
+    {
+        crate::timings::note(|| format!("environment: {name} loaded from {}", path_text(&path)));
+        touch(path.as_deref());
+        return Ok(texels);
+    }
+    let (width, height, texels) = decode()?;
+    if let Some(path) = &path {
+        let mut payload = Vec::with_capacity(8 + 12 * texels.len());
+        put(&mut payload, [width, height]);
+        put(&mut payload, texels.iter().flatten().map(|v| v.to_bits()));
+        FILE_TEXELS.store(path, &key, &payload);
+        prune(path);
+    }
+    Ok((width, height, texels))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -22,7 +22,12 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Environment> {
     let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     let name = path.display().to_string();
     match extension.as_deref() {
-        Some("exr") => from_exr_bytes(&input::read(path, Kind::Environment)?, &name, options),
+        Some("exr") => {
+            // A file's decoded texels are cached by content, as its sampling tables are.
+            let bytes = input::read(path, Kind::Environment)?;
+            let texels = super::cache::file_texels(&bytes, &name, || read_exr_texels(&bytes, &name))?;
+            exr_environment(&bytes, texels, &name, options)
+        }
         Some("hdr") => from_hdr_bytes(&input::read(path, Kind::Environment)?, &name, options),
         _ => Err(Error::input_file(path, "unsupported environment format: use an equirectangular .exr or .hdr")),
     }
@@ -36,7 +41,16 @@ const MAX_DECODED_BYTES: u64 = 2 << 30;
 const BUDGET: Budget = Budget { max_side: input::exr::MAX_SIDE, max_decoded_bytes: MAX_DECODED_BYTES };
 
 pub fn from_exr_bytes(bytes: &[u8], name: &str, options: &LoadOptions) -> Result<Environment> {
-    let (width, height, texels) = read_exr_texels(bytes, name)?;
+    exr_environment(bytes, read_exr_texels(bytes, name)?, name, options)
+}
+
+/// An EXR file's environment from its decoded texels.
+fn exr_environment(
+    bytes: &[u8],
+    (width, height, texels): (u32, u32, Vec<[f32; 3]>),
+    name: &str,
+    options: &LoadOptions,
+) -> Result<Environment> {
     let mut environment = validate(width, height, texels, name, options)?;
     environment.content_hash = super::content_hash(bytes);
     Ok(environment)

@@ -2,6 +2,8 @@
 //! wedges and turntables. The renderer, g-buffer and environment are set up once.
 
 use super::progressive;
+use super::renderer::KernelSource;
+use super::sampling::Sampling;
 use super::scene::covered_object_ids;
 use super::settings::Settings;
 use super::Renderer;
@@ -29,7 +31,21 @@ impl<'a> Batch<'a> {
         gbuffer_name: &'a Path,
         environment: &'a Environment,
     ) -> Result<Batch<'a>> {
-        Ok(Batch { renderer: Renderer::new(ctx, gbuffer, environment)?, gbuffer, gbuffer_name, environment })
+        Batch::with_kernels(ctx, gbuffer, gbuffer_name, environment, Sampling::default(), KernelSource::default())
+    }
+
+    /// A batch whose renderer starts with `kernels` and the estimator `sampling`
+    /// ([`Renderer::with_kernels`]): those of the first render, so that it compiles nothing.
+    pub fn with_kernels(
+        ctx: &Context,
+        gbuffer: &'a GBuffer,
+        gbuffer_name: &'a Path,
+        environment: &'a Environment,
+        sampling: Sampling,
+        kernels: KernelSource,
+    ) -> Result<Batch<'a>> {
+        let renderer = Renderer::with_kernels(ctx, gbuffer, environment, sampling, kernels)?;
+        Ok(Batch { renderer, gbuffer, gbuffer_name, environment })
     }
 
     pub fn width(&self) -> u32 {
@@ -44,13 +60,15 @@ impl<'a> Batch<'a> {
     /// `settings.spp`, calling `progress(samples)` after each pass.
     pub fn render(&mut self, look: &Look, settings: &Settings, progress: impl FnMut(u32)) -> Result<()> {
         let stacks = PackedStacks::pack(look, covered_object_ids(self.gbuffer), self.gbuffer, self.gbuffer_name)?;
+        // The noise threshold before the AOVs and the model: with them it gives the kernels'
+        // specialisation, which then changes at most once.
+        self.renderer.set_noise_threshold(settings.noise)?;
         self.renderer.set_accumulate(super::aov::accumulate(&settings.aovs))?;
         self.renderer.set_stacks(&stacks)?;
         self.renderer.set_model(&settings.model)?;
         self.renderer.set_lighting(settings.lighting);
         self.renderer.set_seed(settings.seed);
         self.renderer.set_sampling(settings.sampling, self.environment)?;
-        self.renderer.set_noise_threshold(settings.noise)?;
         progressive::accumulate(&mut self.renderer, settings.spp, progress)?;
         Ok(())
     }

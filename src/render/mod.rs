@@ -12,5 +12,6 @@ pub mod sampling;
 pub mod scene;
 pub mod settings;
 pub mod sheet;
+pub mod startup;
 
 pub use renderer::{Lighting, Renderer};

@@ -92,15 +92,40 @@ impl Renderer {
 
     /// A renderer of a BRDF model (docs/shading.md#brdf-models).
     pub fn with_model(ctx: &Context, gbuffer: &GBuffer, environment: &Environment, model: &Model) -> Result<Renderer> {
+        let specialization = Specialization { model: *model, accumulate: Accumulate::default() };
+        Renderer::with_kernels(ctx, gbuffer, environment, Sampling::default(), KernelSource::Compile(specialization))
+    }
+
+    /// A renderer with the kernels `kernels` gives and the estimator `sampling`: its images are
+    /// uploaded first, then it waits for the kernels, which may be compiling on another thread
+    /// meanwhile ([`crate::render::startup`]). It starts with the kernels' accumulation and
+    /// no noise threshold; set what the render needs, as with any renderer.
+    pub fn with_kernels(
+        ctx: &Context,
+        gbuffer: &GBuffer,
+        environment: &Environment,
+        sampling: Sampling,
+        kernels: KernelSource,
+    ) -> Result<Renderer> {
         let (width, height) = (gbuffer.width, gbuffer.height);
+        let Specialization { model, accumulate } = kernels.specialization();
         let gpu_gbuffer = GpuGBuffer::upload(ctx, gbuffer)?;
-        let accumulate = Accumulate::default();
         let targets = Targets::new(ctx, width, height, accumulate)?;
-        let gpu_environment = upload_environment(ctx, environment, Sampling::default())?;
-        let resolve = ResolvePass::new(ctx)?;
+        let gpu_environment = upload_environment(ctx, environment, sampling)?;
         let lists = PixelLists::new(ctx, gbuffer)?;
-        let relight = RelightPass::new(ctx, model, accumulate, &gpu_gbuffer, &targets, &lists, &gpu_environment)?;
-        let finalize = FinalizePass::new(ctx, &gpu_gbuffer, &targets)?;
+        let kernels = kernels.wait(ctx)?;
+        let resolve = ResolvePass::new(ctx, kernels.resolve);
+        let relight = RelightPass::new(
+            ctx,
+            kernels.relight,
+            &model,
+            accumulate,
+            &gpu_gbuffer,
+            &targets,
+            &lists,
+            &gpu_environment,
+        )?;
+        let finalize = FinalizePass::new(kernels.finalize, &gpu_gbuffer, &targets)?;
         Ok(Renderer {
             ctx: ctx.clone(),
             width,
@@ -124,7 +149,7 @@ impl Renderer {
             passed: false,
             preview: None,
             denoise: None,
-            sampling: Sampling::default(),
+            sampling,
         })
     }
 
@@ -162,8 +187,7 @@ impl Renderer {
     /// Makes the relight kernel accumulate what was asked for, and the variance adaptive
     /// sampling needs; accumulation restarts if that changes.
     fn apply_accumulate(&mut self) -> Result<()> {
-        let accumulate =
-            Accumulate { variance: self.wanted_accumulate.variance || self.noise.is_some(), ..self.wanted_accumulate };
+        let accumulate = kernel_accumulate(self.wanted_accumulate, self.noise);
         if accumulate == self.relight.accumulate {
             return Ok(());
         }
@@ -180,6 +204,7 @@ impl Renderer {
     fn respecialize(&mut self, model: Model, accumulate: Accumulate) -> Result<()> {
         self.relight = RelightPass::new(
             &self.ctx,
+            RelightPass::pipeline(&self.ctx, &model, accumulate)?,
             &model,
             accumulate,
             &self.gbuffer,
@@ -762,5 +787,82 @@ impl Restarted {
     /// Whether row `y`'s restarted pixels have fewer samples than the rest of the row.
     fn lags(&self, y: u32, row_samples: &[u32]) -> bool {
         self.list.row_len(y) > 0 && self.samples[y as usize] < row_samples[y as usize]
+    }
+}
+
+/// What the relight kernel accumulates: what was asked for, and the variance adaptive
+/// sampling needs.
+fn kernel_accumulate(wanted: Accumulate, noise: Option<NoiseThreshold>) -> Accumulate {
+    Accumulate { variance: wanted.variance || noise.is_some(), ..wanted }
+}
+
+/// What the renderer's kernels are specialised for: the BRDF model and what the relight kernel
+/// accumulates. A scene's settings and the AOVs a command writes give it, so the kernels can
+/// compile while the scene uploads.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Specialization {
+    pub model: Model,
+    pub accumulate: Accumulate,
+}
+
+impl Specialization {
+    /// The kernels a render with `settings` needs when it accumulates `wanted` for its AOVs:
+    /// the specialisation the renderer comes to once they are set, so nothing compiles twice.
+    pub fn of_render(settings: &crate::render::settings::Settings, wanted: Accumulate) -> Specialization {
+        Specialization { model: settings.model, accumulate: kernel_accumulate(wanted, settings.noise) }
+    }
+}
+
+/// The renderer's compiled pipelines, for one [`Specialization`].
+pub struct Kernels {
+    pub specialization: Specialization,
+    resolve: crate::gpu::ComputePipeline,
+    relight: crate::gpu::ComputePipeline,
+    finalize: crate::gpu::ComputePipeline,
+}
+
+impl Kernels {
+    /// Compiles them, the relight kernel (by far the slowest) first. Pipeline creation is
+    /// thread-safe, so this may run on any thread while the context is used on others.
+    pub fn compile(ctx: &Context, specialization: Specialization) -> Result<Kernels> {
+        let Specialization { model, accumulate } = specialization;
+        Ok(Kernels {
+            specialization,
+            relight: RelightPass::pipeline(ctx, &model, accumulate)?,
+            resolve: ResolvePass::pipeline(ctx)?,
+            finalize: FinalizePass::pipeline(ctx)?,
+        })
+    }
+}
+
+/// Where a new renderer's kernels come from.
+pub enum KernelSource<'scope> {
+    /// Compiled when the renderer needs them.
+    Compile(Specialization),
+    /// Already compiling on another thread.
+    Pending(crate::render::startup::PendingKernels<'scope>),
+}
+
+impl Default for KernelSource<'_> {
+    /// The default model's kernels, accumulating nothing beside the total, compiled when needed.
+    fn default() -> Self {
+        KernelSource::Compile(Specialization::default())
+    }
+}
+
+impl KernelSource<'_> {
+    pub fn specialization(&self) -> Specialization {
+        match self {
+            KernelSource::Compile(specialization) => *specialization,
+            KernelSource::Pending(pending) => pending.specialization,
+        }
+    }
+
+    /// The kernels, once compiled.
+    fn wait(self, ctx: &Context) -> Result<Kernels> {
+        match self {
+            KernelSource::Compile(specialization) => Kernels::compile(ctx, specialization),
+            KernelSource::Pending(pending) => pending.wait(),
+        }
     }
 }

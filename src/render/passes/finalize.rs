@@ -45,8 +45,8 @@ pub struct FinalizePass {
 }
 
 impl FinalizePass {
-    pub fn new(ctx: &Context, gbuffer: &GpuGBuffer, targets: &Targets) -> Result<FinalizePass> {
-        let pipeline = ComputePipeline::new(ctx, &shaders::FINALIZE, INTERFACE.sets, INTERFACE.push_size())?;
+    /// The pass, with its pipeline compiled by [`FinalizePass::pipeline`], bound to `targets`.
+    pub fn new(pipeline: ComputePipeline, gbuffer: &GpuGBuffer, targets: &Targets) -> Result<FinalizePass> {
         let set = pipeline.bind(
             0,
             &[
@@ -59,6 +59,11 @@ impl FinalizePass {
             ],
         )?;
         Ok(FinalizePass { pipeline, set })
+    }
+
+    /// Compiles `finalize.comp`.
+    pub fn pipeline(ctx: &Context) -> Result<ComputePipeline> {
+        ComputePipeline::new(ctx, &shaders::FINALIZE, INTERFACE.sets, INTERFACE.push_size())
     }
 
     /// Records the pass over `width` pixels of the rows `push` names.

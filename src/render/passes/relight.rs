@@ -127,8 +127,19 @@ pub struct RelightPass {
 }
 
 impl RelightPass {
+    /// Compiles `relight.comp` specialised for `model` and `accumulate`.
+    pub fn pipeline(ctx: &Context, model: &Model, accumulate: Accumulate) -> Result<ComputePipeline> {
+        let mut constants = model.specialization().to_vec();
+        constants.extend([accumulate.lobes as u32, accumulate.variance as u32]);
+        ComputePipeline::specialized(ctx, &shaders::RELIGHT, INTERFACE.sets, INTERFACE.push_size(), &constants)
+    }
+
+    /// The pass, with `pipeline` from [`RelightPass::pipeline`] for the same `model` and
+    /// `accumulate`, bound to the targets and an environment.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: &Context,
+        pipeline: ComputePipeline,
         model: &Model,
         accumulate: Accumulate,
         gbuffer: &GpuGBuffer,
@@ -136,10 +147,6 @@ impl RelightPass {
         lists: &PixelLists,
         environment: &GpuEnvironment,
     ) -> Result<RelightPass> {
-        let mut constants = model.specialization().to_vec();
-        constants.extend([accumulate.lobes as u32, accumulate.variance as u32]);
-        let pipeline =
-            ComputePipeline::specialized(ctx, &shaders::RELIGHT, INTERFACE.sets, INTERFACE.push_size(), &constants)?;
         // The energy table is built on the GPU; a placeholder unless the model compensates.
         let (table, energy) = if model.energy_compensation {
             let table = crate::render::energy::build(ctx, model)?;

@@ -48,13 +48,14 @@ pub struct ResolvePass {
 }
 
 impl ResolvePass {
-    pub fn new(ctx: &Context) -> Result<ResolvePass> {
-        Ok(ResolvePass {
-            ctx: ctx.clone(),
-            pipeline: ComputePipeline::new(ctx, &shaders::RESOLVE, INTERFACE.sets, INTERFACE.push_size())?,
-            stacks: None,
-            changed: None,
-        })
+    /// The pass, with its pipeline compiled by [`ResolvePass::pipeline`].
+    pub fn new(ctx: &Context, pipeline: ComputePipeline) -> ResolvePass {
+        ResolvePass { ctx: ctx.clone(), pipeline, stacks: None, changed: None }
+    }
+
+    /// Compiles `resolve.comp`.
+    pub fn pipeline(ctx: &Context) -> Result<ComputePipeline> {
+        ComputePipeline::new(ctx, &shaders::RESOLVE, INTERFACE.sets, INTERFACE.push_size())
     }
 
     /// Uploads `packed` (and the g-buffer channels it reads) and binds it for [`Self::record`].
