@@ -242,13 +242,7 @@ fn relight_matches_the_cpu_mirror(ctx: &lookdev::gpu::Context, (gbuffer, look, s
     r.render_samples(10).unwrap();
     r.render_samples(14).unwrap();
     let radiance = r.read_radiance().unwrap();
-    let reference = common::reference_render::Reference {
-        gbuffer: &gbuffer,
-        env: &env,
-        distribution: r.sampling().distribution(&env, u32::MAX),
-        lighting,
-        seed,
-    };
+    let reference = common::reference_render::Reference::new(&gbuffer, &env, r.sampling(), lighting, seed);
     let pixels = gbuffer.pixel_count();
     let (mut off, mut covered) = (0, 0);
     for y in 0..gbuffer.height {

@@ -21,9 +21,9 @@ use common::cli::{assert_success, stderr};
 use common::gltf::{plane, srgb_to_linear, Gltf};
 use glam::{Mat3, Vec3};
 use lookdev::asset::bake::jitter_pattern;
-use lookdev::environment::Distribution;
 use lookdev::gbuffer::GBuffer;
 use lookdev::material::Params;
+use lookdev::render::sampling::Sampling;
 use lookdev::render::Lighting;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -270,13 +270,8 @@ fn every_pixel_renders_as_its_own_parameters_rendered_as_constants() {
     assert_eq!((gbuffer.width, gbuffer.height), (SIZE, SIZE));
     let radiance = read_exr(&dir.path().join("render.exr"));
     let env = lookdev::environment::load::load(&sky, &Default::default()).unwrap();
-    let reference = common::reference_render::Reference {
-        gbuffer: &gbuffer,
-        env: &env,
-        distribution: Distribution::build(&env),
-        lighting: Lighting::default(),
-        seed: 0,
-    };
+    let reference =
+        common::reference_render::Reference::new(&gbuffer, &env, Sampling::default(), Lighting::default(), 0);
     // Interior pixels: away from the quad's edges, where the frame's rounding could show.
     let interior = 2..SIZE - 2;
     let (mut worst, mut worst_at, mut sum, mut count) = (0.0f32, (0, 0), 0.0f64, 0usize);

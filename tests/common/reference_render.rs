@@ -3,10 +3,12 @@
 //! is slow and exact to float rounding, for comparing the GPU kernel pixel by pixel.
 
 use glam::{Vec2, Vec3, Vec4};
+use lookdev::environment::product::{cluster_of, Product};
 use lookdev::environment::sampling::{background, direction_to_uv, texel_of};
 use lookdev::environment::{Distribution, Environment};
 use lookdev::gbuffer::GBuffer;
 use lookdev::material::Params;
+use lookdev::render::sampling::Sampling;
 use lookdev::render::Lighting;
 use lookdev::shading::brdf::{disney_brdf, make_half_vector, make_lobes, make_view};
 use lookdev::shading::frame::{environment_from_world, Frame};
@@ -17,11 +19,20 @@ pub struct Reference<'a> {
     pub gbuffer: &'a GBuffer,
     pub env: &'a Environment,
     pub distribution: Distribution,
+    /// The product tables, when the estimator samples by them.
+    pub product: Option<Product>,
     pub lighting: Lighting,
     pub seed: u32,
 }
 
-impl Reference<'_> {
+impl<'a> Reference<'a> {
+    /// The mirror of a render of `gbuffer` under `env` with the estimator `sampling`.
+    pub fn new(gbuffer: &'a GBuffer, env: &'a Environment, sampling: Sampling, lighting: Lighting, seed: u32) -> Self {
+        let distribution = sampling.distribution(env, u32::MAX);
+        let product = sampling.product(&distribution);
+        Reference { gbuffer, env, distribution, product, lighting, seed }
+    }
+
     /// The final linear radiance of pixel (x, y) after `spp` samples, as `read_radiance` gives
     /// it, for a pixel whose resolved material is `params`: the mean of the summed estimates,
     /// composited over the background by coverage (finalize.comp).
@@ -67,9 +78,19 @@ impl Reference<'_> {
         let pixel_seed = hash_combine(hash_u32(self.seed), y * g.width + x);
         let env_seed = hash_combine(pixel_seed, 0x454e56);
         let brdf_seed = hash_combine(pixel_seed, 0x425244);
+        // choose_environment: the normal's cluster's table alone (q = 1) with product tables.
+        let cluster = self.product.as_ref().map(|p| cluster_of(env_frame.n, p.grid));
+        let pdf_env = |t| match (&self.product, cluster) {
+            (Some(p), Some(c)) => p.mixture_pdf(&self.distribution, c, 1.0, t),
+            _ => self.distribution.texel_cell_pdf(t),
+        };
+        let sample_env = |u| match (&self.product, cluster) {
+            (Some(p), Some(c)) => p.sample_mixture(&self.distribution, c, 1.0, u),
+            _ => self.distribution.sample(u),
+        };
         let texel = |d: Vec3| {
             let t = texel_of(self.env.width, self.env.height, direction_to_uv(d));
-            (Vec3::from(self.env.texel(t.x, t.y)), self.distribution.texel_cell_pdf(t))
+            (Vec3::from(self.env.texel(t.x, t.y)), pdf_env(t))
         };
         let emission = Vec3::from(params.emission);
         if v.z <= 0.0 {
@@ -78,8 +99,8 @@ impl Reference<'_> {
         for s in 0..spp {
             let mut radiance = Vec3::ZERO;
             let (u_env, u_brdf): (Vec2, Vec2) = (sobol_owen_2d(s, env_seed), sobol_owen_2d(s, brdf_seed));
-            let (d, t) = self.distribution.sample(u_env);
-            let (le, pdf_env) = (Vec3::from(self.env.texel(t.x, t.y)), self.distribution.texel_cell_pdf(t));
+            let (d, t) = sample_env(u_env);
+            let (le, pdf_env) = (Vec3::from(self.env.texel(t.x, t.y)), pdf_env(t));
             let l = env_frame.to_local(d);
             if l.z > 0.0 && pdf_env > 0.0 {
                 let hv = make_half_vector(&lobes, l, v);
