@@ -29,6 +29,9 @@ layout(local_size_x = 64) in;
 // code below is specialised away and the images bound are 1×1 placeholders.
 layout(constant_id = 6) const uint LOBE_AOVS = 0u;
 layout(constant_id = 7) const uint VARIANCE_AOV = 0u;
+// Whether the environment sample is drawn by the product tables (--sampling product): a
+// constant, so that the kernel of each estimator holds only its own sampler.
+layout(constant_id = 8) const uint PRODUCT_SAMPLING = 0u;
 
 #include "common.glsl"
 #include "material.glsl"
@@ -96,7 +99,7 @@ vec3 to_environment(vec3 d) {
                 d.x * pass.sin_rotation + d.z * pass.cos_rotation);
 }
 
-// How a pixel samples the environment: with product tables (env_product_grid != 0), from its
+// How a pixel samples the environment: with product tables (PRODUCT_SAMPLING), from its
 // normal's cluster's table with probability q, else from the global tables.
 struct EnvChoice {
     uint cluster;
@@ -105,7 +108,7 @@ struct EnvChoice {
 
 // The share of the cluster's table in the environment sample (docs/shading.md#sampling).
 EnvChoice choose_environment(LobeChoice choice, vec3 fn) {
-    if (env_product_grid == 0u) {
+    if (PRODUCT_SAMPLING == 0u) {
         return EnvChoice(0u, 0.0);
     }
     return EnvChoice(env_cluster(fn), 1.0);
@@ -113,7 +116,7 @@ EnvChoice choose_environment(LobeChoice choice, vec3 fn) {
 
 // The environment sample, its texel and the pdf_ω MIS uses (a).
 vec3 sample_environment(EnvChoice env, vec2 u, out vec4 texel) {
-    if (env_product_grid == 0u) {
+    if (PRODUCT_SAMPLING == 0u) {
         return env_sample(u, texel);
     }
     return env_sample_mixture(env.cluster, env.q, u, texel);
@@ -121,7 +124,7 @@ vec3 sample_environment(EnvChoice env, vec2 u, out vec4 texel) {
 
 // The texel at uv, with the pdf_ω of sample_environment in a.
 vec4 environment_texel(EnvChoice env, vec2 uv) {
-    return env_product_grid == 0u ? env_texel(uv) : env_texel_mixture(env.cluster, env.q, uv);
+    return PRODUCT_SAMPLING == 0u ? env_texel(uv) : env_texel_mixture(env.cluster, env.q, uv);
 }
 
 // One MIS estimate of reflected radiance toward the view; the frame (fx, fy, fn) is the shading

@@ -92,7 +92,7 @@ impl Renderer {
 
     /// A renderer of a BRDF model (docs/shading.md#brdf-models).
     pub fn with_model(ctx: &Context, gbuffer: &GBuffer, environment: &Environment, model: &Model) -> Result<Renderer> {
-        let specialization = Specialization { model: *model, accumulate: Accumulate::default() };
+        let specialization = Specialization { model: *model, ..Specialization::default() };
         Renderer::with_kernels(ctx, gbuffer, environment, Sampling::default(), KernelSource::Compile(specialization))
     }
 
@@ -108,7 +108,7 @@ impl Renderer {
         kernels: KernelSource,
     ) -> Result<Renderer> {
         let (width, height) = (gbuffer.width, gbuffer.height);
-        let Specialization { model, accumulate } = kernels.specialization();
+        let Specialization { model, accumulate, product } = kernels.specialization();
         let gpu_gbuffer = GpuGBuffer::upload(ctx, gbuffer)?;
         let targets = Targets::new(ctx, width, height, accumulate)?;
         let gpu_environment = upload_environment(ctx, environment, sampling)?;
@@ -126,7 +126,7 @@ impl Renderer {
             &gpu_environment,
         )?;
         let finalize = FinalizePass::new(kernels.finalize, &gpu_gbuffer, &targets)?;
-        Ok(Renderer {
+        let mut renderer = Renderer {
             ctx: ctx.clone(),
             width,
             height,
@@ -150,7 +150,12 @@ impl Renderer {
             preview: None,
             denoise: None,
             sampling,
-        })
+        };
+        // Kernels compiled for another estimator's sampler are replaced, not used.
+        if product != sampling.product_kernel() {
+            renderer.respecialize(model, accumulate)?;
+        }
+        Ok(renderer)
     }
 
     /// Replaces the environment (its texels and sampling tables); accumulation restarts.
@@ -204,7 +209,7 @@ impl Renderer {
     fn respecialize(&mut self, model: Model, accumulate: Accumulate) -> Result<()> {
         self.relight = RelightPass::new(
             &self.ctx,
-            RelightPass::pipeline(&self.ctx, &model, accumulate)?,
+            RelightPass::pipeline(&self.ctx, &model, accumulate, self.sampling.product_kernel())?,
             &model,
             accumulate,
             &self.gbuffer,
@@ -748,8 +753,13 @@ impl Renderer {
         if sampling == self.sampling {
             return Ok(());
         }
+        let respecialize = sampling.product_kernel() != self.sampling.product_kernel();
         self.sampling = sampling;
-        self.set_environment(environment)
+        self.set_environment(environment)?;
+        if respecialize {
+            self.respecialize(self.relight.shading.model, self.relight.accumulate)?;
+        }
+        Ok(())
     }
 
     /// Uploads new layer stacks and resolves them, as [`Renderer::set_stacks`] does, but
@@ -799,17 +809,34 @@ fn kernel_accumulate(wanted: Accumulate, noise: Option<NoiseThreshold>) -> Accum
 /// What the renderer's kernels are specialised for: the BRDF model and what the relight kernel
 /// accumulates. A scene's settings and the AOVs a command writes give it, so the kernels can
 /// compile while the scene uploads.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Specialization {
     pub model: Model,
     pub accumulate: Accumulate,
+    /// The environment sampled by product tables ([`Sampling::product_kernel`]).
+    pub product: bool,
+}
+
+impl Default for Specialization {
+    /// The default model and estimator, accumulating nothing beside the total.
+    fn default() -> Self {
+        Specialization {
+            model: Model::default(),
+            accumulate: Accumulate::default(),
+            product: Sampling::default().product_kernel(),
+        }
+    }
 }
 
 impl Specialization {
     /// The kernels a render with `settings` needs when it accumulates `wanted` for its AOVs:
     /// the specialisation the renderer comes to once they are set, so nothing compiles twice.
     pub fn of_render(settings: &crate::render::settings::Settings, wanted: Accumulate) -> Specialization {
-        Specialization { model: settings.model, accumulate: kernel_accumulate(wanted, settings.noise) }
+        Specialization {
+            model: settings.model,
+            accumulate: kernel_accumulate(wanted, settings.noise),
+            product: settings.sampling.product_kernel(),
+        }
     }
 }
 
@@ -825,10 +852,10 @@ impl Kernels {
     /// Compiles them, the relight kernel (by far the slowest) first. Pipeline creation is
     /// thread-safe, so this may run on any thread while the context is used on others.
     pub fn compile(ctx: &Context, specialization: Specialization) -> Result<Kernels> {
-        let Specialization { model, accumulate } = specialization;
+        let Specialization { model, accumulate, product } = specialization;
         Ok(Kernels {
             specialization,
-            relight: RelightPass::pipeline(ctx, &model, accumulate)?,
+            relight: RelightPass::pipeline(ctx, &model, accumulate, product)?,
             resolve: ResolvePass::pipeline(ctx)?,
             finalize: FinalizePass::pipeline(ctx)?,
         })

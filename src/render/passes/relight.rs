@@ -127,10 +127,11 @@ pub struct RelightPass {
 }
 
 impl RelightPass {
-    /// Compiles `relight.comp` specialised for `model` and `accumulate`.
-    pub fn pipeline(ctx: &Context, model: &Model, accumulate: Accumulate) -> Result<ComputePipeline> {
+    /// Compiles `relight.comp` specialised for `model` and `accumulate`, sampling the environment
+    /// by the product tables when `product` is set.
+    pub fn pipeline(ctx: &Context, model: &Model, accumulate: Accumulate, product: bool) -> Result<ComputePipeline> {
         let mut constants = model.specialization().to_vec();
-        constants.extend([accumulate.lobes as u32, accumulate.variance as u32]);
+        constants.extend([accumulate.lobes as u32, accumulate.variance as u32, product as u32]);
         ComputePipeline::specialized(ctx, &shaders::RELIGHT, INTERFACE.sets, INTERFACE.push_size(), &constants)
     }
 
