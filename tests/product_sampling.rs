@@ -218,3 +218,47 @@ fn the_sampling_flag_selects_product_sampling() {
     }
     assert_ne!(images[0], images[1], "--sampling product made no difference");
 }
+
+/// Each estimator has its own specialisation of the relight kernel: a renderer switched from
+/// one to another, or handed kernels compiled for the other, renders the bits of one built for
+/// it (a kernel left with the other's sampler would sample tables that are not there, or not
+/// the ones uploaded).
+#[test]
+fn switching_the_estimator_switches_the_kernel() {
+    use lookdev::render::renderer::{KernelSource, Renderer, Specialization};
+    let ctx = common::gpu::context();
+    let gbuffer = orthographic_sphere(16);
+    let env = Builtin::find("studio").unwrap().load();
+    let look = material(Params { base_color: [0.8, 0.3, 0.1], roughness: 0.7, ..Params::default() });
+    let stacks = lookdev::material::stack::PackedStacks::pack(
+        &look,
+        lookdev::render::scene::covered_object_ids(&gbuffer),
+        &gbuffer,
+        std::path::Path::new("sphere"),
+    )
+    .unwrap();
+    let render = |r: &mut Renderer| {
+        r.set_stacks(&stacks).unwrap();
+        r.set_seed(3);
+        r.render_samples(6).unwrap();
+        r.read_radiance().unwrap()
+    };
+    let built_for = |sampling: Sampling, product_kernel: bool| {
+        let kernels = KernelSource::Compile(Specialization { product: product_kernel, ..Specialization::default() });
+        Renderer::with_kernels(&ctx, &gbuffer, &env, sampling, kernels).unwrap()
+    };
+    let compensated = render(&mut built_for(Sampling::Compensated, false));
+    let product = render(&mut built_for(Sampling::Product, true));
+    assert_ne!(compensated, product);
+    // Kernels compiled for the other estimator are replaced.
+    assert_eq!(render(&mut built_for(Sampling::Compensated, true)), compensated);
+    assert_eq!(render(&mut built_for(Sampling::Product, false)), product);
+    // And so are they when the estimator changes.
+    let mut r = built_for(Sampling::Product, true);
+    r.set_sampling(Sampling::Compensated, &env).unwrap();
+    assert_eq!(render(&mut r), compensated);
+    r.set_sampling(Sampling::Product, &env).unwrap();
+    assert_eq!(render(&mut r), product);
+    drop(r);
+    common::gpu::finish(ctx);
+}
