@@ -5,7 +5,6 @@
 
 mod common;
 
-use common::cli::{assert_success, lookdev};
 use common::probes::{Setup, SAMPLE_PROBE};
 use common::random::Random;
 use common::scenes::{orthographic_sphere, renderer};
@@ -202,21 +201,6 @@ fn product_sampling_is_deterministic_and_its_aov_twin_agrees() {
     assert_ne!(a, r.read_radiance().unwrap());
     drop(r);
     common::gpu::finish(ctx);
-}
-
-/// `--sampling product` renders, and another image than the default estimator's.
-#[test]
-fn the_sampling_flag_selects_product_sampling() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut images = Vec::new();
-    for sampling in ["compensated", "product"] {
-        let out = dir.path().join(format!("{sampling}.exr"));
-        let out_text = out.to_str().unwrap();
-        let args = ["render", "--size", "24", "24", "--spp", "2", "--sampling", sampling, "--out", out_text, "-q"];
-        assert_success(&lookdev(&args));
-        images.push(std::fs::read(&out).unwrap());
-    }
-    assert_ne!(images[0], images[1], "--sampling product made no difference");
 }
 
 /// Each estimator has its own specialisation of the relight kernel: a renderer switched from
