@@ -5,18 +5,17 @@
 mod common;
 
 use common::cli::{assert_bad_input, assert_success, lookdev};
-use common::probes::{Setup, SAMPLE_PROBE};
+use common::probes::environment_samples;
 use common::random::Random;
-use common::scenes::{orthographic_sphere, renderer};
+use common::scenes::{one_material, orthographic_sphere, renderer};
 use common::stats::chi_square;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use lookdev::environment::{sampling, Builtin, Distribution, Environment, GpuEnvironment};
-use lookdev::gpu::{shaders, Binding, Buffer, ComputePipeline, Context};
-use lookdev::material::{Look, Params};
+use lookdev::gpu::Context;
+use lookdev::material::Params;
 use lookdev::render::renderer::Accumulate;
 use lookdev::render::sampling::Sampling;
 use lookdev::render::{progressive, Lighting};
-use lookdev::shading::model::Model;
 
 /// sample_probe.comp's environment routine.
 const ENVIRONMENT: u32 = 4;
@@ -29,43 +28,10 @@ fn gpu_environment_samples(
     distribution: &Distribution,
     count: usize,
 ) -> Vec<(Vec3, f32)> {
-    let model = Model::default();
-    let pipeline = ComputePipeline::specialized(
-        ctx,
-        &shaders::SAMPLE_PROBE,
-        SAMPLE_PROBE.sets,
-        SAMPLE_PROBE.push_size(),
-        &model.specialization(),
-    )
-    .unwrap();
-    let (energy, _) = common::gpu::model_shading(ctx, &model);
-    let setup = Setup {
-        params: Params::default().brdf_gpu(),
-        view: [0.0, 0.0, 1.0, 0.0],
-        routine: ENVIRONMENT,
-        seed: 0,
-        pad: [0; 2],
-    };
-    let setup = Buffer::with_data(ctx, bytemuck::bytes_of(&setup)).unwrap();
     let mut rng = Random::new(7);
-    let flat: Vec<f32> = (0..2 * count).map(|_| rng.uniform()).collect();
-    let uniforms = Buffer::with_data(ctx, bytemuck::cast_slice(&flat)).unwrap();
-    let output = Buffer::storage(ctx, count as u64 * 16).unwrap();
+    let u: Vec<Vec2> = (0..count).map(|_| Vec2::new(rng.uniform(), rng.uniform())).collect();
     let gpu_env = GpuEnvironment::upload(ctx, env, distribution).unwrap();
-    let set0 = pipeline
-        .bind(
-            0,
-            &[Binding::Buffer(&setup), Binding::Buffer(&uniforms), Binding::Buffer(&output), Binding::Buffer(&energy)],
-        )
-        .unwrap();
-    let set1 = pipeline.bind(1, &gpu_env.bindings()).unwrap();
-    ctx.run(|cmd| {
-        pipeline.dispatch(cmd, &[&set0, &set1], &[], [(count as u32).div_ceil(64), 1, 1]);
-        Ok(())
-    })
-    .unwrap();
-    let values: Vec<[f32; 4]> = bytemuck::cast_slice(&output.read(ctx).unwrap()).to_vec();
-    values.iter().map(|v| (Vec3::new(v[0], v[1], v[2]), v[3])).collect()
+    environment_samples(ctx, &gpu_env, ENVIRONMENT, 0, 0.0, &u)
 }
 
 /// The compensated tables sample what they say, cell by cell (grouped into 16 × 8 blocks of
@@ -126,12 +92,6 @@ fn compensated_environment_sampling_matches_its_pdf() {
     common::gpu::finish(ctx);
 }
 
-fn material(params: Params) -> Look {
-    let mut look = Look::default_material();
-    look.objects[0].layers[0].params = params;
-    look
-}
-
 /// Every estimator's image has the plain one's mean, within the noise its variance AOV
 /// reports: over the whole sphere and pixel by pixel, on real HDRIs with a rough dielectric
 /// and a glossy metal.
@@ -150,7 +110,7 @@ fn every_estimator_is_unbiased() {
         let env = Builtin::find(name).unwrap().load();
         for params in &materials {
             let lighting = Lighting { rotation_degrees: 40.0, intensity: 1.0, background: false };
-            let mut r = renderer(&ctx, &gbuffer, &env, &material(*params), lighting);
+            let mut r = renderer(&ctx, &gbuffer, &env, &one_material(*params), lighting);
             r.set_accumulate(Accumulate { variance: true, ..Accumulate::default() }).unwrap();
             let mut images = Vec::new();
             for sampling in Sampling::ALL {

@@ -5,19 +5,18 @@
 
 mod common;
 
-use common::probes::{Setup, SAMPLE_PROBE};
+use common::probes::environment_samples;
 use common::random::Random;
-use common::scenes::{orthographic_sphere, renderer};
+use common::scenes::{one_material, orthographic_sphere, renderer};
 use common::stats::chi_square;
 use glam::{Vec2, Vec3};
 use lookdev::environment::product::{cluster_of, Product, GRID};
 use lookdev::environment::{sampling, Builtin, Distribution, Environment, GpuEnvironment};
-use lookdev::gpu::{shaders, Binding, Buffer, ComputePipeline, Context};
-use lookdev::material::{Look, Params};
+use lookdev::gpu::Context;
+use lookdev::material::Params;
 use lookdev::render::renderer::Accumulate;
 use lookdev::render::sampling::Sampling;
 use lookdev::render::Lighting;
-use lookdev::shading::model::Model;
 
 /// sample_probe.comp's product routine.
 const PRODUCT: u32 = 7;
@@ -34,42 +33,8 @@ fn gpu_product_samples(
     q: f32,
     u: &[Vec2],
 ) -> Vec<(Vec3, f32)> {
-    let model = Model::default();
-    let pipeline = ComputePipeline::specialized(
-        ctx,
-        &shaders::SAMPLE_PROBE,
-        SAMPLE_PROBE.sets,
-        SAMPLE_PROBE.push_size(),
-        &model.specialization(),
-    )
-    .unwrap();
-    let (energy, _) = common::gpu::model_shading(ctx, &model);
-    let setup = Setup {
-        params: Params::default().brdf_gpu(),
-        view: [0.0, 0.0, 1.0, q],
-        routine: PRODUCT,
-        seed: cluster,
-        pad: [0; 2],
-    };
-    let setup = Buffer::with_data(ctx, bytemuck::bytes_of(&setup)).unwrap();
-    let flat: Vec<f32> = u.iter().flat_map(|u| [u.x, u.y]).collect();
-    let uniforms = Buffer::with_data(ctx, bytemuck::cast_slice(&flat)).unwrap();
-    let output = Buffer::storage(ctx, u.len() as u64 * 16).unwrap();
     let gpu_env = GpuEnvironment::upload_with(ctx, env, d, Some(product)).unwrap();
-    let set0 = pipeline
-        .bind(
-            0,
-            &[Binding::Buffer(&setup), Binding::Buffer(&uniforms), Binding::Buffer(&output), Binding::Buffer(&energy)],
-        )
-        .unwrap();
-    let set1 = pipeline.bind(1, &gpu_env.bindings()).unwrap();
-    ctx.run(|cmd| {
-        pipeline.dispatch(cmd, &[&set0, &set1], &[], [(u.len() as u32).div_ceil(64), 1, 1]);
-        Ok(())
-    })
-    .unwrap();
-    let values: Vec<[f32; 4]> = bytemuck::cast_slice(&output.read(ctx).unwrap()).to_vec();
-    values.iter().map(|v| (Vec3::new(v[0], v[1], v[2]), v[3])).collect()
+    environment_samples(ctx, &gpu_env, PRODUCT, cluster, q, u)
 }
 
 /// A dim sky over dark ground with a small, very bright sun.
@@ -148,12 +113,6 @@ fn gpu_product_samples_follow_the_rust_pdf() {
     common::gpu::finish(ctx);
 }
 
-fn material(params: Params) -> Look {
-    let mut look = Look::default_material();
-    look.objects[0].layers[0].params = params;
-    look
-}
-
 /// Product sampling gives the same bits for the same seed however the samples are split into
 /// passes and bands, a different image for another seed, and the same total with the lobe AOVs
 /// on (estimate_lobes is estimate's twin), whose lobes sum to it.
@@ -162,7 +121,8 @@ fn product_sampling_is_deterministic_and_its_aov_twin_agrees() {
     let ctx = common::gpu::context();
     let gbuffer = orthographic_sphere(24);
     let env = Builtin::find("interior").unwrap().load();
-    let look = material(Params { base_color: [0.7, 0.5, 0.3], roughness: 0.6, clearcoat: 0.5, ..Params::default() });
+    let look =
+        one_material(Params { base_color: [0.7, 0.5, 0.3], roughness: 0.6, clearcoat: 0.5, ..Params::default() });
     let lighting = Lighting { rotation_degrees: 70.0, intensity: 1.0, background: false };
     let render = |splits: &[u32], seed: u32, accumulate: Accumulate| {
         let mut r = renderer(&ctx, &gbuffer, &env, &look, lighting);
@@ -213,7 +173,7 @@ fn switching_the_estimator_switches_the_kernel() {
     let ctx = common::gpu::context();
     let gbuffer = orthographic_sphere(16);
     let env = Builtin::find("studio").unwrap().load();
-    let look = material(Params { base_color: [0.8, 0.3, 0.1], roughness: 0.7, ..Params::default() });
+    let look = one_material(Params { base_color: [0.8, 0.3, 0.1], roughness: 0.7, ..Params::default() });
     let stacks = lookdev::material::stack::PackedStacks::pack(
         &look,
         lookdev::render::scene::covered_object_ids(&gbuffer),

@@ -61,3 +61,10 @@ id = 1
 [object.layer.set]
 emission = [0.9, 0.05, 0.0]
 "#;
+
+/// The default look with its one layer set to `params`: one material everywhere.
+pub fn one_material(params: lookdev::material::Params) -> Look {
+    let mut look = Look::default_material();
+    look.objects[0].layers[0].params = params;
+    look
+}
