@@ -78,7 +78,7 @@ fn committed_spirv_matches_the_glsl() {
         // The exact command the committed files come from.
         let status = Command::new("glslangValidator")
             .current_dir(root())
-            .args(["--quiet", "--target-env", "vulkan1.3", "-Iglsl", "-Iglsl/include", "-o"])
+            .args(["--quiet", "--target-env", "vulkan1.3", "-Os", "-Iglsl", "-Iglsl/include", "-o"])
             .arg(&out)
             .arg(kernel.strip_prefix(root()).unwrap())
             .status()
