@@ -31,6 +31,11 @@ layout(set = 1, binding = 3, std430) readonly buffer EnvInfo {
     uint env_product_grid;    // product sampling: clusters per cube-face side; 0 when off
     uint env_coarse_columns;  // coarse cells, each a block of cells
     uint env_coarse_rows;
+    // Product sampling's lookups (Product::index), which spare each sample integer divisions
+    // that lavapipe runs lane by lane: each texel column's coarse column; each texel row's
+    // coarse row times env_coarse_columns; then per coarse cell its columns of cells
+    // c0 | c1 << 16 and its rows r0 | r1 << 16.
+    uint env_product_index[];
 };
 // Product sampling (src/environment/product.rs): the bucket entries and CDFs, laid out as
 // env_buckets and env_cdf are, of one table per cluster of normals over the coarse cells (rows
@@ -173,11 +178,6 @@ uint env_cluster(vec3 n) {
     return (face * grid + cell.y) * grid + cell.x;
 }
 
-// The first cell of coarse cell i of `coarse` along an axis of `cells` cells.
-uint env_coarse_start(uint i, uint coarse, uint cells) {
-    return i * cells / coarse;
-}
-
 // The product tables' rows: the clusters' tables, then the coarse cells', then the ratios.
 uint env_clusters() {
     return 6u * env_product_grid * env_product_grid;
@@ -185,10 +185,9 @@ uint env_clusters() {
 
 // The ratio of `cluster`'s product pdf to the global pdf at texel `at`.
 float env_product_ratio(uint cluster, uvec2 at) {
-    uint cc = ((at.x / env_block_x + 1u) * env_coarse_columns - 1u) / env_columns;
-    uint cr = ((at.y / env_block_y + 1u) * env_coarse_rows - 1u) / env_rows;
+    uint c = env_product_index[at.x] + env_product_index[env_width + at.y];
     uint cells = env_coarse_columns * env_coarse_rows;
-    return imageLoad(env_product_cdf, ivec2(cr * env_coarse_columns + cc, env_clusters() + cells + cluster)).x;
+    return imageLoad(env_product_cdf, ivec2(c, env_clusters() + cells + cluster)).x;
 }
 
 // env_search on the product tables.
@@ -227,12 +226,13 @@ vec3 env_sample_product(uint cluster, vec2 u, out uvec2 at) {
     uint cells = env_coarse_columns * env_coarse_rows;
     uint c = env_product_search(cluster, cells, u.x, bounds);
     float ux = env_rescale(u.x, bounds);
-    uint cr = c / env_coarse_columns;
-    uint cc = c % env_coarse_columns;
-    uint r0 = env_coarse_start(cr, env_coarse_rows, env_rows);
-    uint r1 = env_coarse_start(cr + 1u, env_coarse_rows, env_rows);
-    uint c0 = env_coarse_start(cc, env_coarse_columns, env_columns);
-    uint c1 = env_coarse_start(cc + 1u, env_coarse_columns, env_columns);
+    uint span_at = env_width + env_height + 2u * c;
+    uint columns = env_product_index[span_at];
+    uint rows = env_product_index[span_at + 1u];
+    uint c0 = columns & 0xffffu;
+    uint c1 = columns >> 16;
+    uint r0 = rows & 0xffffu;
+    uint r1 = rows >> 16;
     uint k = env_product_search(env_clusters() + c, r1 - r0, u.y, bounds);
     float dv = env_rescale(u.y, bounds);
     uint row = r0 + k;

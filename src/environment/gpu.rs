@@ -60,12 +60,18 @@ impl GpuEnvironment {
         product_buckets.upload(ctx, bytemuck::cast_slice(&bucket_texels))?;
         let product_cdf = Image::new(ctx, vk::Format::R32_SFLOAT, width, height, 1, false)?;
         product_cdf.upload(ctx, bytemuck::cast_slice(&cdf_texels))?;
-        let mut header = [0u32; 12];
-        header[..8].copy_from_slice(&distribution.header());
-        if let Some(p) = product {
-            header[6..9].copy_from_slice(&[p.grid, p.coarse_columns, p.coarse_rows]);
+        // EnvInfo: the header, then env_product_index (one unused word when off, as a buffer
+        // may not be empty).
+        let mut info = vec![0u32; 9];
+        info[..8].copy_from_slice(&distribution.header());
+        match product {
+            Some(p) => {
+                info[6..9].copy_from_slice(&[p.grid, p.coarse_columns, p.coarse_rows]);
+                info.extend(&p.index);
+            }
+            None => info.push(0),
         }
-        let info = Buffer::with_data(ctx, bytemuck::cast_slice(&header))?;
+        let info = Buffer::with_data(ctx, bytemuck::cast_slice(&info))?;
         Ok(GpuEnvironment { texels, buckets, cdf, info, product_buckets, product_cdf })
     }
 

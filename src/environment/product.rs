@@ -18,7 +18,7 @@
 //!   sampler is the global one times ratio(c) = P(c)/G(c), P(c) the cluster table's probability:
 //!   one more fetch turns the stored pdf into the product pdf, for any direction.
 
-use super::distribution::{Distribution, Table};
+use super::distribution::{Distribution, Table, MAX_CELLS};
 use super::sampling::texel_of;
 use crate::shading::common::ONE_MINUS_EPSILON;
 use glam::{UVec2, Vec2, Vec3};
@@ -48,6 +48,12 @@ pub struct Product {
     pub cells: Vec<Table>,
     /// P(c)/G(c) per cluster and coarse cell: the product pdf over the global one.
     pub ratio: Vec<f32>,
+    /// Lookups that spare each sample the integer divisions of [`coarse_of`] and
+    /// [`coarse_start`] (which lavapipe runs lane by lane), as `env_product_index` holds them:
+    /// each texel column's coarse column; each texel row's coarse row times `coarse_columns`;
+    /// then two words per coarse cell, its columns of global cells `c0 | c1 << 16` and its rows
+    /// `r0 | r1 << 16`.
+    pub index: Vec<u32>,
 }
 
 /// The first global cell of coarse cell `i` of `coarse` along an axis of `cells` cells.
@@ -219,7 +225,32 @@ impl Product {
             }));
             clusters.push(table);
         }
-        Product { grid, coarse_columns, coarse_rows, columns, rows, clusters, cells, ratio }
+        let index = Product::build_index(d, coarse_columns, coarse_rows);
+        Product { grid, coarse_columns, coarse_rows, columns, rows, clusters, cells, ratio, index }
+    }
+
+    /// [`Product::index`] for the global tables `d` grouped into coarse cells.
+    fn build_index(d: &Distribution, coarse_columns: u32, coarse_rows: u32) -> Vec<u32> {
+        let (columns, rows) = (d.columns, d.rows);
+        // The spans are packed in 16 bits: a side has at most MAX_CELLS cells.
+        debug_assert!(columns <= MAX_CELLS && rows <= MAX_CELLS && MAX_CELLS < 1 << 16);
+        let span = |i, coarse, cells| coarse_start(i, coarse, cells) | coarse_start(i + 1, coarse, cells) << 16;
+        let mut index = Vec::with_capacity((d.width + d.height + 2 * coarse_columns * coarse_rows) as usize);
+        index.extend((0..d.width).map(|x| coarse_of(x / d.block_x, coarse_columns, columns)));
+        index.extend((0..d.height).map(|y| coarse_of(y / d.block_y, coarse_rows, rows) * coarse_columns));
+        for cr in 0..coarse_rows {
+            for cc in 0..coarse_columns {
+                index.extend([span(cc, coarse_columns, columns), span(cr, coarse_rows, rows)]);
+            }
+        }
+        index
+    }
+
+    /// Coarse cell `c`'s global cells: columns `c0 .. c1` and rows `r0 .. r1`, as (c0, c1, r0, r1).
+    fn coarse_span(&self, d: &Distribution, c: u32) -> (u32, u32, u32, u32) {
+        let at = (d.width + d.height + 2 * c) as usize;
+        let (columns, rows) = (self.index[at], self.index[at + 1]);
+        (columns & 0xffff, columns >> 16, rows & 0xffff, rows >> 16)
     }
 
     /// The tables as `glsl/include/environment.glsl` reads them: two images of
@@ -269,9 +300,7 @@ impl Product {
 
     /// The coarse cell holding texel `t` of the global tables `d`.
     pub fn coarse_cell(&self, d: &Distribution, t: UVec2) -> u32 {
-        let cc = coarse_of(t.x / d.block_x, self.coarse_columns, self.columns);
-        let cr = coarse_of(t.y / d.block_y, self.coarse_rows, self.rows);
-        cr * self.coarse_columns + cc
+        self.index[t.x as usize] + self.index[(d.width + t.y) as usize]
     }
 
     /// The product pdf over its global pdf of a direction in texel `t`, for `cluster`.
@@ -293,12 +322,7 @@ impl Product {
         let table = &self.clusters[cluster as usize];
         let c = table.search(u.x);
         let ux = rescale(u.x, table.cdf[c], table.cdf[c + 1]);
-        let (cr, cc) = (c as u32 / self.coarse_columns, c as u32 % self.coarse_columns);
-        let r0 = coarse_start(cr, self.coarse_rows, self.rows);
-        let (c0, c1) = (
-            coarse_start(cc, self.coarse_columns, self.columns),
-            coarse_start(cc + 1, self.coarse_columns, self.columns),
-        );
+        let (c0, c1, r0, _) = self.coarse_span(d, c as u32);
         let cell = &self.cells[c];
         let k = cell.search(u.y);
         let dv = rescale(u.y, cell.cdf[k], cell.cdf[k + 1]);
@@ -344,6 +368,42 @@ mod tests {
                 previous = c;
             }
             assert_eq!(previous, coarse - 1);
+        }
+    }
+
+    /// The lookups that replace the divisions agree with them: each texel's coarse cell spans
+    /// the texel's cell, and the spans tile the grid.
+    #[test]
+    fn the_index_puts_each_texel_in_the_coarse_cell_that_spans_it() {
+        let blocked = Environment::new(45, 23, (0..45 * 23).map(|i| [(i % 11) as f32 + 0.5; 3]).collect(), "blocked");
+        for (env, max_cells) in [(sun_map(), 4096), (blocked, 7), (Environment::new(1, 1, vec![[0.5; 3]], "1x1"), 4096)]
+        {
+            let d = Distribution::compensated_with_max_cells(&env, max_cells);
+            let p = Product::build(&d);
+            let mut covered = vec![0u32; (d.columns * d.rows) as usize];
+            for c in 0..p.coarse_cells() {
+                let (c0, c1, r0, r1) = p.coarse_span(&d, c);
+                assert_eq!(
+                    (c0, r0),
+                    (
+                        coarse_start(c % p.coarse_columns, p.coarse_columns, d.columns),
+                        coarse_start(c / p.coarse_columns, p.coarse_rows, d.rows)
+                    )
+                );
+                for r in r0..r1 {
+                    for column in c0..c1 {
+                        covered[(r * d.columns + column) as usize] += 1;
+                    }
+                }
+            }
+            assert!(covered.iter().all(|&n| n == 1), "{}: the spans do not tile the grid", env.source);
+            for y in 0..d.height {
+                for x in 0..d.width {
+                    let (c0, c1, r0, r1) = p.coarse_span(&d, p.coarse_cell(&d, UVec2::new(x, y)));
+                    let (column, row) = (x / d.block_x, y / d.block_y);
+                    assert!((c0..c1).contains(&column) && (r0..r1).contains(&row), "{}: texel ({x}, {y})", env.source);
+                }
+            }
         }
     }
 
