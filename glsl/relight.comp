@@ -99,41 +99,30 @@ vec3 to_environment(vec3 d) {
                 d.x * pass.sin_rotation + d.z * pass.cos_rotation);
 }
 
-// How a pixel samples the environment: with product tables (PRODUCT_SAMPLING), from its
-// normal's cluster's table with probability q, else from the global tables.
-struct EnvChoice {
-    uint cluster;
-    float q;
-};
-
-// The share of the cluster's table in the environment sample (docs/shading.md#sampling).
-EnvChoice choose_environment(LobeChoice choice, vec3 fn) {
-    if (PRODUCT_SAMPLING == 0u) {
-        return EnvChoice(0u, 0.0);
-    }
-    return EnvChoice(env_cluster(fn), 1.0);
+// With product tables (PRODUCT_SAMPLING), a pixel samples the environment from its normal's
+// cluster's table alone (q = 1 of env_sample_mixture, which the kernel does not call: a SIMD
+// driver would run the global sampler masked beside the cluster's for every sample).
+uint environment_cluster(vec3 fn) {
+    return PRODUCT_SAMPLING == 0u ? 0u : env_cluster(fn);
 }
 
 // The environment sample, its texel and the pdf_ω MIS uses (a).
-vec3 sample_environment(EnvChoice env, vec2 u, out vec4 texel) {
-    if (PRODUCT_SAMPLING == 0u) {
-        return env_sample(u, texel);
-    }
-    return env_sample_mixture(env.cluster, env.q, u, texel);
+vec3 sample_environment(uint cluster, vec2 u, out vec4 texel) {
+    return PRODUCT_SAMPLING == 0u ? env_sample(u, texel) : env_sample_cluster(cluster, u, texel);
 }
 
 // The texel at uv, with the pdf_ω of sample_environment in a.
-vec4 environment_texel(EnvChoice env, vec2 uv) {
-    return PRODUCT_SAMPLING == 0u ? env_texel(uv) : env_texel_mixture(env.cluster, env.q, uv);
+vec4 environment_texel(uint cluster, vec2 uv) {
+    return PRODUCT_SAMPLING == 0u ? env_texel(uv) : env_texel_cluster(cluster, uv);
 }
 
 // One MIS estimate of reflected radiance toward the view; the frame (fx, fy, fn) is the shading
 // frame expressed in environment space, so no per-sample rotation is needed.
-vec3 estimate(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, EnvChoice env, vec2 u_env, vec2 u_brdf) {
+vec3 estimate(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, uint cluster, vec2 u_env, vec2 u_brdf) {
     vec3 result = vec3(0.0);
 
     vec4 texel;
-    vec3 d = sample_environment(env, u_env, texel);
+    vec3 d = sample_environment(cluster, u_env, texel);
     vec3 l = vec3(dot(d, fx), dot(d, fy), dot(d, fn));
     if (l.z > 0.0 && texel.a > 0.0) {
         HalfVector hv = make_half_vector(s, l, view.v);
@@ -148,7 +137,7 @@ vec3 estimate(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, 
         float pdf_brdf = brdf_pdf(choice, view, l, hv);
         if (pdf_brdf > 0.0) {
             d = normalize(l.x * fx + l.y * fy + l.z * fn);
-            texel = environment_texel(env, env_direction_to_uv(d));
+            texel = environment_texel(cluster, env_direction_to_uv(d));
             vec3 f = disney_brdf(s, view, l, hv);
             result += f * (l.z * mis_weight_over_pdf(pdf_brdf, texel.a)) * texel.rgb;
         }
@@ -158,7 +147,7 @@ vec3 estimate(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, 
 
 // The same estimate as `estimate`, bit for bit, with each lobe's share of it beside: the
 // lobes' sum is the total up to float rounding.
-vec3 estimate_lobes(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, EnvChoice env, vec2 u_env, vec2 u_brdf,
+vec3 estimate_lobes(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, uint cluster, vec2 u_env, vec2 u_brdf,
                     out vec3 shares[4]) {
     vec3 result = vec3(0.0);
     for (int k = 0; k < 4; k++) {
@@ -167,7 +156,7 @@ vec3 estimate_lobes(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec
     float diffuse_weight = 1.0 - s.metallic;
 
     vec4 texel;
-    vec3 d = sample_environment(env, u_env, texel);
+    vec3 d = sample_environment(cluster, u_env, texel);
     vec3 l = vec3(dot(d, fx), dot(d, fy), dot(d, fn));
     if (l.z > 0.0 && texel.a > 0.0) {
         HalfVector hv = make_half_vector(s, l, view.v);
@@ -187,7 +176,7 @@ vec3 estimate_lobes(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec
         float pdf_brdf = brdf_pdf(choice, view, l, hv);
         if (pdf_brdf > 0.0) {
             d = normalize(l.x * fx + l.y * fy + l.z * fn);
-            texel = environment_texel(env, env_direction_to_uv(d));
+            texel = environment_texel(cluster, env_direction_to_uv(d));
             BrdfLobes b = disney_lobes(s, view, l, hv);
             float w = l.z * mis_weight_over_pdf(pdf_brdf, texel.a);
             result += lobes_total(s, b) * w * texel.rgb;
@@ -288,7 +277,7 @@ void relight(ivec2 pixel, ivec2 size) {
         vec3 fx = to_environment(t);
         vec3 fy = to_environment(b);
         vec3 fn = to_environment(n);
-        EnvChoice env = choose_environment(choice, fn);
+        uint cluster = environment_cluster(fn);
         uint pixel_seed = hash_combine(hash_u32(pass.seed), uint(pixel.y) * uint(size.x) + uint(pixel.x));
         uint env_seed = hash_combine(pixel_seed, 0x454e56u);
         uint brdf_seed = hash_combine(pixel_seed, 0x425244u);
@@ -296,13 +285,13 @@ void relight(ivec2 pixel, ivec2 size) {
             vec3 x;
             if (LOBE_AOVS != 0u) {
                 vec3 shares[4];
-                x = emission + estimate_lobes(s, choice, view_terms, fx, fy, fn, env, sobol_owen_2d(i, env_seed),
+                x = emission + estimate_lobes(s, choice, view_terms, fx, fy, fn, cluster, sobol_owen_2d(i, env_seed),
                                               sobol_owen_2d(i, brdf_seed), shares);
                 for (int k = 0; k < 4; k++) {
                     lobes[k] += shares[k];
                 }
             } else {
-                x = emission + estimate(s, choice, view_terms, fx, fy, fn, env, sobol_owen_2d(i, env_seed),
+                x = emission + estimate(s, choice, view_terms, fx, fy, fn, cluster, sobol_owen_2d(i, env_seed),
                                         sobol_owen_2d(i, brdf_seed));
             }
             sum.rgb += x;

@@ -271,6 +271,25 @@ vec3 env_sample_mixture(uint cluster, float q, vec2 u, out vec4 texel) {
     return d;
 }
 
+// The environment sample of product sampling with q = 1: `cluster`'s table alone. Bit for bit
+// env_sample_mixture(cluster, 1.0, u, texel), without the global sampler's code, which a SIMD
+// driver would otherwise run masked beside it.
+vec3 env_sample_cluster(uint cluster, vec2 u, out vec4 texel) {
+    uvec2 at;
+    vec3 d = env_sample_product(cluster, u, at);
+    texel = imageLoad(env_texels, ivec2(at));
+    texel.a *= env_product_ratio(cluster, at);
+    return d;
+}
+
+// The texel at uv with env_sample_cluster's pdf_ω in a.
+vec4 env_texel_cluster(uint cluster, vec2 uv) {
+    ivec2 at = env_texel_at(uv);
+    vec4 texel = imageLoad(env_texels, at);
+    texel.a *= env_product_ratio(cluster, uvec2(at));
+    return texel;
+}
+
 // The texel at uv with the mixture's pdf_ω in a.
 vec4 env_texel_mixture(uint cluster, float q, vec2 uv) {
     ivec2 at = env_texel_at(uv);
