@@ -8,7 +8,7 @@ mod common;
 use common::scenes::{look, orthographic_sphere};
 use lookdev::environment::Environment;
 use lookdev::gbuffer::GBuffer;
-use lookdev::material::stack::PackedStacks;
+use lookdev::material::stack::{LobesPresent, PackedStacks};
 use lookdev::material::{Look, Param, Value};
 use lookdev::render::{Lighting, Renderer};
 use lookdev::shading::tonemap::Tonemap;
@@ -94,7 +94,7 @@ fn the_resolve_finds_exactly_the_pixels_an_edit_changes() {
         r.render_samples(2).unwrap();
         let before = bits(&r.read_radiance().unwrap());
         let edited = pack(&edit, &gbuffer);
-        let restarted = r.set_stacks_local(&edited).unwrap();
+        let restarted = r.set_stacks_local(&edited).unwrap().expect("no edit changes the scene's lobes");
         let cpu = changed_on_cpu(&gbuffer, &base, &edited);
         assert_eq!(restarted, expected, "{what}");
         assert_eq!(restarted, cpu.len(), "{what}: as many as the CPU blend changes");
@@ -130,7 +130,7 @@ fn a_local_restart_keeps_the_rest_and_catches_up_to_a_fresh_render() {
     lookdev::render::progressive::accumulate(&mut r, spp, |_| {}).unwrap();
     let before = bits(&r.read_radiance().unwrap());
 
-    let restarted = r.set_stacks_local(&edited).unwrap();
+    let restarted = r.set_stacks_local(&edited).unwrap().expect("the same lobes");
     let pedestal: Vec<usize> =
         (0..gbuffer.pixel_count()).filter(|&i| gbuffer.coverage[i] > 0.0 && gbuffer.object_id[i] != 1).collect();
     assert_eq!(restarted, pedestal.len(), "the pedestal's covered pixels, and only they, restart");
@@ -152,9 +152,44 @@ fn a_local_restart_keeps_the_rest_and_catches_up_to_a_fresh_render() {
     lookdev::render::progressive::accumulate(&mut fresh, spp, |_| {}).unwrap();
     assert!(after == bits(&fresh.read_radiance().unwrap()), "equal to a fresh render of the edit, bit for bit");
 
-    assert_eq!(r.set_stacks_local(&original).unwrap(), pedestal.len(), "undo restarts the same pixels");
+    assert_eq!(r.set_stacks_local(&original).unwrap(), Some(pedestal.len()), "undo restarts the same pixels");
     lookdev::render::progressive::accumulate(&mut r, spp, |_| {}).unwrap();
     assert!(bits(&r.read_radiance().unwrap()) == before, "undone, the first image, bit for bit");
+    drop((r, fresh));
+    common::gpu::finish(ctx);
+}
+
+/// An edit that gives the scene a lobe no pixel had (a clear coat on the pedestal, in a scene
+/// of bare metals) needs another specialisation of the relight kernel: every pixel restarts,
+/// and the image is a fresh render's of the edited look, bit for bit. Taking the coat off again
+/// goes back to the first kernel and the first image.
+#[test]
+fn an_edit_that_gives_the_scene_a_lobe_restarts_everything() {
+    let ctx = common::gpu::context();
+    let env = Environment::default_builtin();
+    let gbuffer = GBuffer::shaderball(64, 64);
+    let text = "[[object]]\n[[object.layer]]\npreset = \"chrome\"\n\n[[object]]\nid = 1\n[[object.layer]]\npreset = \"gold\"\n";
+    let original = pack(&look(text), &gbuffer);
+    let coated = pack(&with_set(text, 0, 0, Param::Clearcoat, 1.0), &gbuffer);
+    assert_eq!(original.lobes(), LobesPresent { diffuse: false, clearcoat: false });
+    assert_eq!(coated.lobes(), LobesPresent { diffuse: false, clearcoat: true });
+    let spp = 4;
+
+    let mut r = renderer(&ctx, &gbuffer, &env, &original);
+    lookdev::render::progressive::accumulate(&mut r, spp, |_| {}).unwrap();
+    let before = bits(&r.read_radiance().unwrap());
+    assert_eq!(r.set_stacks_local(&coated).unwrap(), None, "everything restarts");
+    assert_eq!((r.samples(), r.restarted_region(), r.lobes()), (0, None, coated.lobes()));
+    lookdev::render::progressive::accumulate(&mut r, spp, |_| {}).unwrap();
+    let mut fresh = renderer(&ctx, &gbuffer, &env, &coated);
+    lookdev::render::progressive::accumulate(&mut fresh, spp, |_| {}).unwrap();
+    let after = bits(&r.read_radiance().unwrap());
+    assert!(after == bits(&fresh.read_radiance().unwrap()), "equal to a fresh render of the edit, bit for bit");
+    assert!(after != before, "the coat shows");
+
+    assert_eq!(r.set_stacks_local(&original).unwrap(), None, "taking the coat off restarts everything too");
+    lookdev::render::progressive::accumulate(&mut r, spp, |_| {}).unwrap();
+    assert!(bits(&r.read_radiance().unwrap()) == before, "the first image, bit for bit");
     drop((r, fresh));
     common::gpu::finish(ctx);
 }

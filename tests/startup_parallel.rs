@@ -13,7 +13,6 @@ use lookdev::render::renderer::{Accumulate, KernelSource, Specialization};
 use lookdev::render::sampling::Sampling;
 use lookdev::render::scene::{GBufferSpec, Scene, SceneSpec};
 use lookdev::render::settings::Overrides;
-use lookdev::render::settings::Settings;
 use lookdev::render::startup::{self, Started};
 use lookdev::render::Renderer;
 use lookdev::render::{aov, progressive};
@@ -61,7 +60,7 @@ fn the_overlapped_start_up_renders_what_a_serial_one_renders() {
     let options =
         ContextOptions { validation: true, ..ContextOptions::from_env(std::env::var("LOOKDEV_TEST_DEVICE").ok()) };
     let threaded = std::thread::scope(|threads| {
-        let specialize = |settings: &_| Specialization::of_render(settings, wanted);
+        let specialize = |scene: &_| Specialization::of_render(scene, wanted);
         let Started { scene, ctx, kernels } = startup::start(threads, &spec(), options, specialize).unwrap();
         // The noise threshold needs the variance: the kernels are compiled with it already.
         assert_eq!(kernels.specialization.accumulate, Accumulate { lobes: true, variance: true });
@@ -106,7 +105,7 @@ fn a_batch_started_overlapped_renders_what_a_serial_one_renders() {
     let options =
         ContextOptions { validation: true, ..ContextOptions::from_env(std::env::var("LOOKDEV_TEST_DEVICE").ok()) };
     let threaded = std::thread::scope(|threads| {
-        let specialize = |settings: &Settings| Specialization::of_render(settings, aov::accumulate(&settings.aovs));
+        let specialize = |scene: &Scene| Specialization::of_render(scene, aov::accumulate(&scene.settings.aovs));
         let Started { scene, ctx, kernels } = startup::start(threads, &spec, options, specialize).unwrap();
         let (name, sampling) = (Path::new("built-in"), scene.settings.sampling);
         let kernels = KernelSource::Pending(kernels);

@@ -14,6 +14,15 @@
 #include "material.glsl"
 #include "model.glsl"
 
+// Which lobes some pixel of the scene has, from its layer stacks (LobesPresent in
+// src/material/stack.rs): SCENE_DIFFUSE where some metallic is below 1 (the diffuse, subsurface
+// and sheen lobes, all weighted by 1 − metallic), SCENE_CLEARCOAT where some clearcoat is above
+// 0. A kernel specialised without a lobe leaves out its code, which a SIMD driver would
+// otherwise run, masked, for every sample. On by default: every kernel but relight, and the
+// CPU reference, evaluate every lobe.
+layout(constant_id = 9) const uint SCENE_DIFFUSE = 1u;
+layout(constant_id = 10) const uint SCENE_CLEARCOAT = 1u;
+
 // What the BRDF needs of a material, derived once per pixel rather than once per sample.
 struct Lobes {
     vec3 base_color;
@@ -334,7 +343,7 @@ HalfVector make_half_vector(Lobes s, vec3 l, vec3 v) {
     float len2 = dot(sum, sum);
     hv.h = len2 > 0.0 ? sum * inversesqrt(len2) : vec3(0.0);
     hv.d_spec = len2 > 0.0 ? specular_d(s, hv.h) : 0.0;
-    hv.d_coat = len2 > 0.0 ? gtr1(hv.h, s.cc_alpha2, s.cc_norm) : 0.0;
+    hv.d_coat = SCENE_CLEARCOAT != 0u && len2 > 0.0 ? gtr1(hv.h, s.cc_alpha2, s.cc_norm) : 0.0;
     return hv;
 }
 
@@ -485,19 +494,21 @@ BrdfLobes disney_lobes(Lobes s, View view, vec3 l, HalfVector hv) {
     float fl = schlick_weight(cl);
     float fh = schlick_weight(cd);
 
-    // Diffuse: Schlick-style retro-reflection, and the Hanrahan–Krueger-like subsurface.
-    float cd2r = cd * cd * s.roughness;
-    float fss = mix(1.0, cd2r, fl) * mix(1.0, cd2r, view.fv);
-    float ss = 1.25 * (fss * (1.0 / (cl + cv) - 0.5) + 0.5);
-    if (MODEL_DIFFUSE == DIFFUSE_BURLEY2012) {
-        float fd90 = 0.5 + 2.0 * cd2r;
-        float fd = mix(1.0, fd90, fl) * mix(1.0, fd90, view.fv);
-        b.diffuse = (INV_PI * mix(fd, ss, s.subsurface)) * s.base_color;
-    } else {
-        vec3 fd = diffuse_model(s, l, view.v, hv.h, cd, fl, view.fv);
-        b.diffuse = mix(fd, (INV_PI * ss) * s.base_color, s.subsurface);
+    if (SCENE_DIFFUSE != 0u) {
+        // Diffuse: Schlick-style retro-reflection, and the Hanrahan–Krueger-like subsurface.
+        float cd2r = cd * cd * s.roughness;
+        float fss = mix(1.0, cd2r, fl) * mix(1.0, cd2r, view.fv);
+        float ss = 1.25 * (fss * (1.0 / (cl + cv) - 0.5) + 0.5);
+        if (MODEL_DIFFUSE == DIFFUSE_BURLEY2012) {
+            float fd90 = 0.5 + 2.0 * cd2r;
+            float fd = mix(1.0, fd90, fl) * mix(1.0, fd90, view.fv);
+            b.diffuse = (INV_PI * mix(fd, ss, s.subsurface)) * s.base_color;
+        } else {
+            vec3 fd = diffuse_model(s, l, view.v, hv.h, cd, fl, view.fv);
+            b.diffuse = mix(fd, (INV_PI * ss) * s.base_color, s.subsurface);
+        }
+        b.sheen = fh * s.sheen_color;
     }
-    b.sheen = fh * s.sheen_color;
 
     // Specular: the model's D, G and F (anisotropic GGX, separable Smith, Schlick by default).
     vec3 fs = specular_fresnel(s, cd, fh);
@@ -509,16 +520,25 @@ BrdfLobes disney_lobes(Lobes s, View view, vec3 l, HalfVector hv) {
     }
 #endif
 
-    // Clearcoat: GTR1 with a fixed IOR 1.5.
-    float fr = mix(0.04, 1.0, fh);
-    float gr = smith_g_clearcoat(cl) * view.g_coat;
-    b.clearcoat = s.clearcoat * gr * fr * hv.d_coat;
+    if (SCENE_CLEARCOAT != 0u) {
+        // Clearcoat: GTR1 with a fixed IOR 1.5.
+        float fr = mix(0.04, 1.0, fh);
+        float gr = smith_g_clearcoat(cl) * view.g_coat;
+        b.clearcoat = s.clearcoat * gr * fr * hv.d_coat;
+    }
     return b;
 }
 
-// f, the lobes together.
+// f, the lobes together: (diffuse + sheen)·(1 − metallic) + specular + clearcoat.
 vec3 lobes_total(Lobes s, BrdfLobes b) {
-    return (b.diffuse + b.sheen) * (1.0 - s.metallic) + b.specular + vec3(b.clearcoat);
+    vec3 f = b.specular;
+    if (SCENE_DIFFUSE != 0u) {
+        f = (b.diffuse + b.sheen) * (1.0 - s.metallic) + f;
+    }
+    if (SCENE_CLEARCOAT != 0u) {
+        f += vec3(b.clearcoat);
+    }
+    return f;
 }
 
 // f(l, v), without the cosine.

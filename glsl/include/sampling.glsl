@@ -16,15 +16,19 @@ struct LobeChoice {
     float clearcoat;  // GTR1 half vectors
 };
 
+// Whether any pixel's BRDF sample may be drawn from the cosine lobe: the diffuse lobes', and the
+// energy compensation's, whose multiple-scattering lobe is sampled so even on a metal.
+const bool COSINE_LOBE = SCENE_DIFFUSE != 0u || MODEL_ENERGY_COMPENSATION != 0u;
+
 // Picks lobes in proportion to an estimate of their reflectance at this view angle.
 LobeChoice choose_lobes(Lobes s, View view) {
-    float w_diffuse = (1.0 - s.metallic) * (luminance(s.base_color) + 0.25 * luminance(s.sheen_color));
+    float w_diffuse = SCENE_DIFFUSE != 0u ? (1.0 - s.metallic) * (luminance(s.base_color) + 0.25 * luminance(s.sheen_color)) : 0.0;
     if (MODEL_ENERGY_COMPENSATION != 0u) {
         // The multiple-scattering lobe is nearly cosine-shaped; its albedo is F_ms·(1 − E(μv)).
         w_diffuse += luminance(s.ms_fresnel) * view.ms_v;
     }
     float w_specular = luminance(mix(s.cspec0, vec3(1.0), view.fv));
-    float w_clearcoat = s.clearcoat * mix(0.04, 1.0, view.fv);
+    float w_clearcoat = SCENE_CLEARCOAT != 0u ? s.clearcoat * mix(0.04, 1.0, view.fv) : 0.0;
     float total = w_diffuse + w_specular + w_clearcoat;
     if (!(total > 0.0)) {
         return LobeChoice(1.0, 0.0, 0.0);
@@ -134,11 +138,11 @@ float pdf_gtr1_reflection(View view, HalfVector hv) {
 
 // The one-sample MIS pdf of sample_brdf: Σ pᵢ·pdfᵢ(l).
 float brdf_pdf(LobeChoice c, View view, vec3 l, HalfVector hv) {
-    float pdf = c.diffuse * pdf_cosine(l);
+    float pdf = COSINE_LOBE ? c.diffuse * pdf_cosine(l) : 0.0;
     if (c.specular > 0.0) {
         pdf += c.specular * pdf_specular_reflection(view, hv);
     }
-    if (c.clearcoat > 0.0) {
+    if (SCENE_CLEARCOAT != 0u && c.clearcoat > 0.0) {
         pdf += c.clearcoat * pdf_gtr1_reflection(view, hv);
     }
     return pdf;
@@ -149,10 +153,10 @@ float brdf_pdf(LobeChoice c, View view, vec3 l, HalfVector hv) {
 vec3 sample_brdf(Lobes s, LobeChoice c, View view, vec2 u) {
     float x;
     uint lobe;
-    if (u.x < c.diffuse) {
+    if (COSINE_LOBE && u.x < c.diffuse) {
         lobe = 0u;
         x = u.x / c.diffuse;
-    } else if (u.x < c.diffuse + c.specular || c.clearcoat <= 0.0) {
+    } else if (SCENE_CLEARCOAT == 0u || u.x < c.diffuse + c.specular || c.clearcoat <= 0.0) {
         lobe = 1u;
         x = (u.x - c.diffuse) / c.specular;
     } else {
@@ -160,11 +164,11 @@ vec3 sample_brdf(Lobes s, LobeChoice c, View view, vec2 u) {
         x = (u.x - c.diffuse - c.specular) / c.clearcoat;
     }
     vec2 phi = azimuth(min(x, ONE_MINUS_EPSILON));
-    if (lobe == 0u) {
+    if (COSINE_LOBE && lobe == 0u) {
         return sample_cosine(phi, u.y);
     }
-    vec3 h = lobe == 1u ? sample_specular_normal(s, view, phi, u.y)
-                        : sample_gtr1_normal(s.cc_alpha2, s.cc_log2_alpha2, phi, u.y);
+    vec3 h = SCENE_CLEARCOAT == 0u || lobe == 1u ? sample_specular_normal(s, view, phi, u.y)
+                                                 : sample_gtr1_normal(s.cc_alpha2, s.cc_log2_alpha2, phi, u.y);
     return reflect(-view.v, h);
 }
 

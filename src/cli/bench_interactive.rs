@@ -140,7 +140,9 @@ fn run_local_edit(args: &BenchArgs) -> Result<()> {
         for edit in 0..args.edits as usize {
             let stacks = &packed[(edit + 1) % 2];
             let start = Instant::now();
-            pixels = renderer.set_stacks_local(stacks)?;
+            pixels = renderer
+                .set_stacks_local(stacks)?
+                .ok_or_else(|| crate::Error::gpu("the edit changed the scene's lobes: everything restarted"))?;
             progressive::accumulate(&mut renderer, LOCAL_SPP, |_| {})?;
             local.push(start.elapsed());
             if renderer.restarted_region().is_some() {

@@ -139,7 +139,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     // (crate::render::startup).
     let options = ContextOptions::from_env(args.device.clone());
     let (scene, rendered, device_name) = std::thread::scope(|threads| -> Result<_> {
-        let specialize = |settings: &Settings| kernels_for(settings, &output_aovs(format, display, settings));
+        let specialize = |scene: &Scene| kernels_for(scene, &output_aovs(format, display, &scene.settings));
         let Started { scene, ctx, kernels } = startup::start(threads, &spec, options, specialize)?;
         let counter = ctx.validation_counter();
         let device_name = ctx.info().name.clone();
@@ -181,9 +181,9 @@ fn output_aovs(format: OutputFormat, display: Option<Aov>, settings: &Settings) 
     }
 }
 
-/// The kernels a render with `settings` writing `aovs` needs.
-fn kernels_for(settings: &Settings, aovs: &[Aov]) -> Specialization {
-    Specialization::of_render(settings, aov::accumulate(aovs))
+/// The kernels a render of `scene` writing `aovs` needs.
+fn kernels_for(scene: &Scene, aovs: &[Aov]) -> Specialization {
+    Specialization::of_render(scene, aov::accumulate(aovs))
 }
 
 /// The one AOV `--aov-display` shows in a PNG.
@@ -288,7 +288,7 @@ fn run_compare(args: &RenderArgs, format: OutputFormat, second_look: Option<&Pat
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
     let device_name = ctx.info().name.clone();
-    let kernels = |scene: &Scene| KernelSource::Compile(kernels_for(&scene.settings, &[]));
+    let kernels = |scene: &Scene| KernelSource::Compile(kernels_for(scene, &[]));
     let first = render(&ctx, &a, kernels(&a), &[], "rendering A", args.quiet)?;
     let second = match second_scene {
         Second::Look(b) => render(&ctx, &b, kernels(&b), &[], "rendering B", args.quiet)?,

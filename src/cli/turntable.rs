@@ -13,7 +13,6 @@ use crate::render::batch::Batch;
 use crate::render::output::{self, Metadata, OutputFormat};
 use crate::render::renderer::{KernelSource, Specialization};
 use crate::render::scene::Scene;
-use crate::render::settings::Settings;
 use crate::render::startup::{self, Started};
 use crate::{Error, Result};
 use clap::Args;
@@ -103,7 +102,7 @@ pub fn run(args: TurntableArgs) -> Result<()> {
     // (crate::render::startup).
     let options = ContextOptions::from_env(args.device.clone());
     std::thread::scope(|threads| {
-        let specialize = |settings: &Settings| Specialization::of_render(settings, aov::accumulate(&settings.aovs));
+        let specialize = |scene: &Scene| Specialization::of_render(scene, aov::accumulate(&scene.settings.aovs));
         let Started { scene, ctx, kernels } = startup::start(threads, &spec, options, specialize)?;
         let counter = ctx.validation_counter();
         scene.check_device(ctx.info())?;

@@ -242,6 +242,19 @@ impl PackedStacks {
         Ok(packed)
     }
 
+    /// Which lobes some pixel these stacks resolve may have, for the relight kernel's
+    /// specialisation. Resolving blends layers convexly and maps only scale a layer's value,
+    /// so a clearcoat 0 in every layer resolves to 0 everywhere, and a metallic 1 with no map
+    /// in every layer to exactly 1 (fl(fl(1 − w) + w) = 1 for w in [0, 1]).
+    pub fn lobes(&self) -> LobesPresent {
+        let metallic = Param::Metallic.gpu_index();
+        let clearcoat = Param::Clearcoat.gpu_index();
+        LobesPresent {
+            diffuse: self.layers.iter().any(|l| l.params[metallic] != 1.0 || l.maps[metallic] != NONE),
+            clearcoat: self.layers.iter().any(|l| l.params[clearcoat] != 0.0),
+        }
+    }
+
     /// The GPU channel layer of a g-buffer channel, added on first use.
     fn channel_index(&mut self, channel: &str) -> i32 {
         let index = self.channels.iter().position(|c| c == channel).unwrap_or_else(|| {
@@ -269,6 +282,25 @@ impl PackedStacks {
     pub fn resolve_gbuffer_pixel(&self, gbuffer: &GBuffer, index: usize) -> Params {
         let channel_value = |i: usize| gbuffer.layer_channel(&self.channels[i]).map_or(0.0, |values| values[index]);
         self.resolve_pixel(gbuffer.object_id[index], channel_value)
+    }
+}
+
+/// The lobes a scene's materials may have somewhere ([`PackedStacks::lobes`]): the relight
+/// kernel is specialised for them (`SCENE_DIFFUSE`, `SCENE_CLEARCOAT` in `brdf.glsl`), so that
+/// it leaves out the code of lobes no pixel has. Images differ from those of a kernel with every
+/// lobe only by float rounding (the compiler may fuse what remains differently).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct LobesPresent {
+    /// Some pixel's metallic is below 1: the diffuse, subsurface and sheen lobes.
+    pub diffuse: bool,
+    /// Some pixel's clearcoat is above 0.
+    pub clearcoat: bool,
+}
+
+impl Default for LobesPresent {
+    /// Every lobe: right for any scene.
+    fn default() -> Self {
+        LobesPresent { diffuse: true, clearcoat: true }
     }
 }
 
@@ -371,6 +403,30 @@ mod tests {
         // One channel of a colour map is a grey for a colour parameter.
         for (c, e) in [2.0f32, 4.0, 8.0].into_iter().enumerate() {
             assert!((p.emission[c] - mixed(0.0, e * 0.25)).abs() < 1e-6, "{:?}", p.emission);
+        }
+    }
+
+    #[test]
+    fn the_lobes_present_are_those_some_enabled_layer_can_give_a_pixel() {
+        let metal = |clearcoat: f32, enabled: bool| {
+            let mut l = layer(0.3, Some("stripes"), enabled);
+            (l.params.metallic, l.params.clearcoat) = (1.0, clearcoat);
+            l
+        };
+        let lobes = |layers| pack(layers).lobes();
+        let none = LobesPresent { diffuse: false, clearcoat: false };
+        assert_eq!(lobes(vec![metal(0.0, true), metal(0.0, true)]), none, "metals blend to metallic 1");
+        assert_eq!(lobes(vec![metal(0.0, true), metal(0.5, false)]), none, "a disabled layer gives nothing");
+        assert_eq!(lobes(vec![metal(0.0, true), metal(0.5, true)]), LobesPresent { clearcoat: true, ..none });
+        assert_eq!(lobes(vec![metal(0.0, true), layer(0.3, None, true)]), LobesPresent { diffuse: true, ..none });
+        // A map only scales a value: it can take metallic below 1, but not clearcoat above 0.
+        let mut mapped = metal(0.0, true);
+        mapped.maps = [(Param::Metallic, "rough".to_string()), (Param::Clearcoat, "rough".to_string())].into();
+        assert_eq!(lobes(vec![mapped]), LobesPresent { diffuse: true, ..none });
+        // fl(fl(1 − w) + w) = 1 for every weight: what makes metals blend to exactly 1.
+        for k in 0..=1_000_000u32 {
+            let w = k as f32 / 1_000_000.0;
+            assert_eq!(1.0f32 * (1.0 - w) + 1.0 * w, 1.0, "w = {w}");
         }
     }
 

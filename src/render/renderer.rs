@@ -11,7 +11,7 @@ use crate::environment::{Environment, GpuEnvironment};
 use crate::gbuffer::gpu::GpuGBuffer;
 use crate::gbuffer::GBuffer;
 use crate::gpu::{Buffer, Context, GpuTimer, Image};
-use crate::material::stack::PackedStacks;
+use crate::material::stack::{LobesPresent, PackedStacks};
 use crate::render::sampling::Sampling;
 use crate::shading::brdf::Shading;
 use crate::shading::model::Model;
@@ -82,6 +82,8 @@ pub struct Renderer {
     denoise: Option<DenoisePass>,
     /// The estimator: which environment tables are uploaded.
     sampling: Sampling,
+    /// The lobes the relight kernel is specialised for: those of the stacks last set.
+    lobes: LobesPresent,
 }
 
 impl Renderer {
@@ -108,7 +110,7 @@ impl Renderer {
         kernels: KernelSource,
     ) -> Result<Renderer> {
         let (width, height) = (gbuffer.width, gbuffer.height);
-        let Specialization { model, accumulate, product } = kernels.specialization();
+        let Specialization { model, accumulate, product, lobes } = kernels.specialization();
         let gpu_gbuffer = GpuGBuffer::upload(ctx, gbuffer)?;
         let targets = Targets::new(ctx, width, height, accumulate)?;
         let gpu_environment = upload_environment(ctx, environment, sampling)?;
@@ -150,6 +152,7 @@ impl Renderer {
             preview: None,
             denoise: None,
             sampling,
+            lobes,
         };
         // Kernels compiled for another estimator's sampler are replaced, not used.
         if product != sampling.product_kernel() {
@@ -209,7 +212,7 @@ impl Renderer {
     fn respecialize(&mut self, model: Model, accumulate: Accumulate) -> Result<()> {
         self.relight = RelightPass::new(
             &self.ctx,
-            RelightPass::pipeline(&self.ctx, &model, accumulate, self.sampling.product_kernel())?,
+            RelightPass::pipeline(&self.ctx, &model, accumulate, self.sampling.product_kernel(), self.lobes)?,
             &model,
             accumulate,
             &self.gbuffer,
@@ -354,13 +357,30 @@ impl Renderer {
     }
 
     /// Uploads new layer stacks and resolves them into one material per pixel (once per edit,
-    /// not per sample). Accumulation restarts.
+    /// not per sample). Accumulation restarts, and the relight kernel is respecialised if the
+    /// stacks have other lobes ([`PackedStacks::lobes`]).
     pub fn set_stacks(&mut self, packed: &PackedStacks) -> Result<()> {
         self.resolve.set_stacks(&self.ctx, &mut self.gbuffer, packed, &self.targets)?;
         let (width, height) = (self.width, self.height);
         self.timed(|renderer, cmd| renderer.resolve.record(cmd, width, height))?;
+        self.set_lobes(packed.lobes())?;
         self.restart();
         Ok(())
+    }
+
+    /// Specialises the relight kernel for `lobes`, restarting accumulation, unless it is.
+    fn set_lobes(&mut self, lobes: LobesPresent) -> Result<bool> {
+        if lobes == self.lobes {
+            return Ok(false);
+        }
+        self.lobes = lobes;
+        self.respecialize(self.relight.shading.model, self.relight.accumulate)?;
+        Ok(true)
+    }
+
+    /// The lobes the relight kernel is specialised for.
+    pub fn lobes(&self) -> LobesPresent {
+        self.lobes
     }
 
     /// Runs `record` in one submission, bracketed by timestamps when the device has them.
@@ -767,13 +787,19 @@ impl Renderer {
     /// ([`Renderer::restart_pixels`]); every other pixel keeps its samples. Returns how many
     /// changed: an edit of one object's stack restarts that object's pixels, one of a masked
     /// layer those where its weight is not 0 (docs/commands.md#edit-local-re-convergence).
-    pub fn set_stacks_local(&mut self, packed: &PackedStacks) -> Result<usize> {
+    /// An edit that gives the scene a lobe no pixel had, or takes away the last pixel's, needs
+    /// another specialisation of the relight kernel ([`PackedStacks::lobes`]): then everything
+    /// restarts, as with [`Renderer::set_stacks`], and this returns None.
+    pub fn set_stacks_local(&mut self, packed: &PackedStacks) -> Result<Option<usize>> {
         self.resolve.set_stacks(&self.ctx, &mut self.gbuffer, packed, &self.targets)?;
         let (width, height) = (self.width, self.height);
         self.timed(|renderer, cmd| renderer.resolve.record(cmd, width, height))?;
         let changed = self.resolve.changed_pixels(width as usize * height as usize)?;
+        if self.set_lobes(packed.lobes())? {
+            return Ok(None);
+        }
         self.restart_pixels(&changed);
-        Ok(changed.len())
+        Ok(Some(changed.len()))
     }
 }
 
@@ -806,15 +832,17 @@ fn kernel_accumulate(wanted: Accumulate, noise: Option<NoiseThreshold>) -> Accum
     Accumulate { variance: wanted.variance || noise.is_some(), ..wanted }
 }
 
-/// What the renderer's kernels are specialised for: the BRDF model and what the relight kernel
-/// accumulates. A scene's settings and the AOVs a command writes give it, so the kernels can
-/// compile while the scene uploads.
+/// What the renderer's kernels are specialised for: the BRDF model, what the relight kernel
+/// accumulates, its environment sampler and the lobes its materials have. A scene and the AOVs
+/// a command writes give it, so the kernels can compile while the scene uploads.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Specialization {
     pub model: Model,
     pub accumulate: Accumulate,
     /// The environment sampled by product tables ([`Sampling::product_kernel`]).
     pub product: bool,
+    /// The lobes of the scene's stacks ([`PackedStacks::lobes`]).
+    pub lobes: LobesPresent,
 }
 
 impl Default for Specialization {
@@ -824,18 +852,22 @@ impl Default for Specialization {
             model: Model::default(),
             accumulate: Accumulate::default(),
             product: Sampling::default().product_kernel(),
+            lobes: LobesPresent::default(),
         }
     }
 }
 
 impl Specialization {
-    /// The kernels a render with `settings` needs when it accumulates `wanted` for its AOVs:
-    /// the specialisation the renderer comes to once they are set, so nothing compiles twice.
-    pub fn of_render(settings: &crate::render::settings::Settings, wanted: Accumulate) -> Specialization {
+    /// The kernels a render of `scene` needs when it accumulates `wanted` for its AOVs: the
+    /// specialisation the renderer comes to once its settings and stacks are set, so nothing
+    /// compiles twice.
+    pub fn of_render(scene: &crate::render::scene::Scene, wanted: Accumulate) -> Specialization {
+        let settings = &scene.settings;
         Specialization {
             model: settings.model,
             accumulate: kernel_accumulate(wanted, settings.noise),
             product: settings.sampling.product_kernel(),
+            lobes: scene.stacks.lobes(),
         }
     }
 }
@@ -852,10 +884,10 @@ impl Kernels {
     /// Compiles them, the relight kernel (by far the slowest) first. Pipeline creation is
     /// thread-safe, so this may run on any thread while the context is used on others.
     pub fn compile(ctx: &Context, specialization: Specialization) -> Result<Kernels> {
-        let Specialization { model, accumulate, product } = specialization;
+        let Specialization { model, accumulate, product, lobes } = specialization;
         Ok(Kernels {
             specialization,
-            relight: RelightPass::pipeline(ctx, &model, accumulate, product)?,
+            relight: RelightPass::pipeline(ctx, &model, accumulate, product, lobes)?,
             resolve: ResolvePass::pipeline(ctx)?,
             finalize: FinalizePass::pipeline(ctx)?,
         })

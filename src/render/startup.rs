@@ -10,7 +10,6 @@
 use crate::gpu::{Context, ContextOptions};
 use crate::render::renderer::{Kernels, Specialization};
 use crate::render::scene::{Scene, SceneSpec};
-use crate::render::settings::Settings;
 use crate::Result;
 use std::thread::{Scope, ScopedJoinHandle};
 
@@ -36,14 +35,14 @@ pub struct Started<'scope> {
 }
 
 /// Loads the scene `spec` names on this thread while a thread of `threads` opens the device
-/// `options` name; then starts compiling, on another, the kernels `specialize` chooses from the
-/// scene's settings. The scope joins the threads however this ends. A bad scene is reported
+/// `options` name; then starts compiling, on another, the kernels `specialize` chooses for the
+/// scene. The scope joins the threads however this ends. A bad scene is reported
 /// before a device that failed to open, as when one step follows the other.
 pub fn start<'scope>(
     threads: &'scope Scope<'scope, '_>,
     spec: &SceneSpec,
     options: ContextOptions,
-    specialize: impl FnOnce(&Settings) -> Specialization,
+    specialize: impl FnOnce(&Scene) -> Specialization,
 ) -> Result<Started<'scope>> {
     let opening = threads.spawn(move || Context::new(&options));
     let scene = {
@@ -52,7 +51,7 @@ pub fn start<'scope>(
     };
     let ctx = opening.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
     let (scene, ctx) = (scene?, ctx?);
-    let specialization = specialize(&scene.settings);
+    let specialization = specialize(&scene);
     let compiling = ctx.clone();
     let thread = threads.spawn(move || Kernels::compile(&compiling, specialization));
     Ok(Started { scene, ctx, kernels: PendingKernels { specialization, thread } })

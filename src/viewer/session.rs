@@ -498,16 +498,19 @@ impl Session {
                 // Locally only once a first pass has replaced the preview: until then, rows
                 // still shown from it would keep the old materials.
                 if !whole && self.progressive.first_pass.is_some() {
-                    self.renderer.set_stacks_local(&packed)?;
-                    restarted_locally = true;
+                    // None: the edit changed the scene's lobes, and everything restarted.
+                    restarted_locally = self.renderer.set_stacks_local(&packed)?.is_some();
+                    restarted = !restarted_locally;
                 } else {
                     self.renderer.set_stacks(&packed)?;
                     restarted = true;
                 }
                 if let Some(b) = self.compare.as_mut().filter(|b| matches!(b.subject, Subject::Model(_))) {
                     if !whole && b.progressive.first_pass.is_some() {
-                        b.renderer.set_stacks_local(&packed)?;
-                        b.progressive.restart_local();
+                        match b.renderer.set_stacks_local(&packed)? {
+                            Some(_) => b.progressive.restart_local(),
+                            None => b.progressive.restart(),
+                        }
                     } else {
                         b.renderer.set_stacks(&packed)?;
                         b.progressive.restart();

@@ -9,6 +9,7 @@ use crate::gbuffer::gpu::GpuGBuffer;
 use crate::gpu::{
     shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, GlslLayout, Interface,
 };
+use crate::material::stack::LobesPresent;
 use crate::shading::brdf::EnergyTable;
 use crate::shading::brdf::Shading;
 use crate::shading::model::Model;
@@ -128,10 +129,17 @@ pub struct RelightPass {
 
 impl RelightPass {
     /// Compiles `relight.comp` specialised for `model` and `accumulate`, sampling the environment
-    /// by the product tables when `product` is set.
-    pub fn pipeline(ctx: &Context, model: &Model, accumulate: Accumulate, product: bool) -> Result<ComputePipeline> {
+    /// by the product tables when `product` is set, with the code of the lobes in `lobes` only.
+    pub fn pipeline(
+        ctx: &Context,
+        model: &Model,
+        accumulate: Accumulate,
+        product: bool,
+        lobes: LobesPresent,
+    ) -> Result<ComputePipeline> {
         let mut constants = model.specialization().to_vec();
         constants.extend([accumulate.lobes as u32, accumulate.variance as u32, product as u32]);
+        constants.extend([lobes.diffuse as u32, lobes.clearcoat as u32]);
         ComputePipeline::specialized(ctx, &shaders::RELIGHT, INTERFACE.sets, INTERFACE.push_size(), &constants)
     }
 
