@@ -31,16 +31,18 @@ layout(set = 1, binding = 3, std430) readonly buffer EnvInfo {
     uint env_product_grid;    // product sampling: clusters per cube-face side; 0 when off
     uint env_coarse_columns;  // coarse cells, each a block of cells
     uint env_coarse_rows;
+    uint env_product_ratio_row;  // env_product_cdf's row of cluster 0's ratios
     // Product sampling's lookups (Product::index), which spare each sample integer divisions
     // that lavapipe runs lane by lane: each texel column's coarse column; each texel row's
     // coarse row times env_coarse_columns; then per coarse cell its columns of cells
-    // c0 | c1 << 16 and its rows r0 | r1 << 16.
+    // c0 | c1 << 16, its rows r0 | r1 << 16, and where its table starts, x | row << 16.
     uint env_product_index[];
 };
 // Product sampling (src/environment/product.rs): the bucket entries and CDFs, laid out as
-// env_buckets and env_cdf are, of one table per cluster of normals over the coarse cells (rows
-// 0 .. clusters − 1), then one per coarse cell over its rows of cells; env_product_cdf then holds
-// one row per cluster of the ratio of its pdf to the global pdf in each coarse cell. 1×1
+// env_buckets and env_cdf are, of one table per cluster of normals over the coarse cells (row k
+// for cluster k), then one per coarse cell over its rows of cells, several to a row (most are
+// short), where env_product_index says; env_product_cdf then holds, from env_product_ratio_row
+// on, one row per cluster of the ratio of its pdf to the global pdf in each coarse cell. 1×1
 // placeholders when off.
 layout(set = 1, binding = 4, rgba32f) uniform readonly image2D env_product_buckets;
 layout(set = 1, binding = 5, r32f) uniform readonly image2D env_product_cdf;
@@ -178,36 +180,30 @@ uint env_cluster(vec3 n) {
     return (face * grid + cell.y) * grid + cell.x;
 }
 
-// The product tables' rows: the clusters' tables, then the coarse cells', then the ratios.
-uint env_clusters() {
-    return 6u * env_product_grid * env_product_grid;
-}
-
 // The ratio of `cluster`'s product pdf to the global pdf at texel `at`.
 float env_product_ratio(uint cluster, uvec2 at) {
     uint c = env_product_index[at.x] + env_product_index[env_width + at.y];
-    uint cells = env_coarse_columns * env_coarse_rows;
-    return imageLoad(env_product_cdf, ivec2(c, env_clusters() + cells + cluster)).x;
+    return imageLoad(env_product_cdf, ivec2(c, env_product_ratio_row + cluster)).x;
 }
 
-// env_search on the product tables.
-uint env_product_search(uint table, uint n, float u, out vec2 bounds) {
+// env_search on the product table that starts at texel `origin`.
+uint env_product_search(ivec2 origin, uint n, float u, out vec2 bounds) {
     uint k = min(uint(u * float(n)), n - 1u);
-    vec4 entry = imageLoad(env_product_buckets, ivec2(k, table));
+    vec4 entry = imageLoad(env_product_buckets, origin + ivec2(k, 0));
     uint lo = uint(entry.z);
     uint hi = uint(entry.w) + 1u;
     bounds = entry.xy;
     if (hi - lo > 1u) {
         while (hi - lo > 1u) {
             uint mid = (lo + hi) >> 1;
-            if (imageLoad(env_product_cdf, ivec2(mid, table)).x <= u) {
+            if (imageLoad(env_product_cdf, origin + ivec2(mid, 0)).x <= u) {
                 lo = mid;
             } else {
                 hi = mid;
             }
         }
-        bounds = vec2(imageLoad(env_product_cdf, ivec2(lo, table)).x,
-                      imageLoad(env_product_cdf, ivec2(lo + 1u, table)).x);
+        bounds = vec2(imageLoad(env_product_cdf, origin + ivec2(lo, 0)).x,
+                      imageLoad(env_product_cdf, origin + ivec2(lo + 1u, 0)).x);
     }
     return lo;
 }
@@ -224,16 +220,17 @@ float env_rescale(float u, vec2 bounds) {
 vec3 env_sample_product(uint cluster, vec2 u, out uvec2 at) {
     vec2 bounds;
     uint cells = env_coarse_columns * env_coarse_rows;
-    uint c = env_product_search(cluster, cells, u.x, bounds);
+    uint c = env_product_search(ivec2(0, cluster), cells, u.x, bounds);
     float ux = env_rescale(u.x, bounds);
-    uint span_at = env_width + env_height + 2u * c;
+    uint span_at = env_width + env_height + 3u * c;
     uint columns = env_product_index[span_at];
     uint rows = env_product_index[span_at + 1u];
+    uint table = env_product_index[span_at + 2u];
     uint c0 = columns & 0xffffu;
     uint c1 = columns >> 16;
     uint r0 = rows & 0xffffu;
     uint r1 = rows >> 16;
-    uint k = env_product_search(env_clusters() + c, r1 - r0, u.y, bounds);
+    uint k = env_product_search(ivec2(table & 0xffffu, table >> 16), r1 - r0, u.y, bounds);
     float dv = env_rescale(u.y, bounds);
     uint row = r0 + k;
     float a = imageLoad(env_cdf, ivec2(c0, 1u + row)).x;

@@ -46,27 +46,29 @@ impl GpuEnvironment {
         buckets.upload(ctx, bytemuck::cast_slice(&bucket_texels))?;
         let cdf = Image::new(ctx, vk::Format::R32_SFLOAT, width, height, 1, false)?;
         cdf.upload(ctx, bytemuck::cast_slice(&cdf_texels))?;
-        let (width, height, bucket_texels, cdf_texels) = match product {
-            Some(p) => p.table_texels(),
-            None => (1, 1, vec![[0.0; 4]], vec![0.0]),
+        let (width, bucket_rows, cdf_rows, bucket_texels, cdf_texels) = match product {
+            Some(p) => p.table_texels(distribution),
+            None => (1, 1, 1, vec![[0.0; 4]], vec![0.0]),
         };
-        if width > max || height > max {
+        if width > max || cdf_rows > max {
             return Err(Error::input_file(
                 &env.source,
-                format!("its product tables need {width}x{height} images, larger than this device's {max} pixel limit"),
+                format!(
+                    "its product tables need {width}x{cdf_rows} images, larger than this device's {max} pixel limit"
+                ),
             ));
         }
-        let product_buckets = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 1, false)?;
+        let product_buckets = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, bucket_rows, 1, false)?;
         product_buckets.upload(ctx, bytemuck::cast_slice(&bucket_texels))?;
-        let product_cdf = Image::new(ctx, vk::Format::R32_SFLOAT, width, height, 1, false)?;
+        let product_cdf = Image::new(ctx, vk::Format::R32_SFLOAT, width, cdf_rows, 1, false)?;
         product_cdf.upload(ctx, bytemuck::cast_slice(&cdf_texels))?;
         // EnvInfo: the header, then env_product_index (one unused word when off, as a buffer
         // may not be empty).
-        let mut info = vec![0u32; 9];
+        let mut info = vec![0u32; 10];
         info[..8].copy_from_slice(&distribution.header());
         match product {
             Some(p) => {
-                info[6..9].copy_from_slice(&[p.grid, p.coarse_columns, p.coarse_rows]);
+                info[6..10].copy_from_slice(&[p.grid, p.coarse_columns, p.coarse_rows, p.ratio_row()]);
                 info.extend(&p.index);
             }
             None => info.push(0),

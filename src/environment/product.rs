@@ -51,9 +51,36 @@ pub struct Product {
     /// Lookups that spare each sample the integer divisions of [`coarse_of`] and
     /// [`coarse_start`] (which lavapipe runs lane by lane), as `env_product_index` holds them:
     /// each texel column's coarse column; each texel row's coarse row times `coarse_columns`;
-    /// then two words per coarse cell, its columns of global cells `c0 | c1 << 16` and its rows
-    /// `r0 | r1 << 16`.
+    /// then three words per coarse cell, its columns of global cells `c0 | c1 << 16`, its rows
+    /// `r0 | r1 << 16`, and where its table starts in the table images, `x | row << 16`.
     pub index: Vec<u32>,
+    /// The rows of the table images the coarse cells' tables take, packed several to a row
+    /// after the clusters' tables (most have a few entries; a row is as wide as a cluster's).
+    pub cell_rows: u32,
+}
+
+/// The width of the product tables' images: the longest table's CDF (its entries and 1).
+fn table_width(clusters: &[Table], cells: &[Table]) -> u32 {
+    clusters.iter().chain(cells).map(Table::len).max().unwrap_or(0) as u32 + 1
+}
+
+/// Places the coarse cells' tables (each its CDF's length) one after another in rows `width`
+/// texels wide from row `first_row` on, starting a row where the next does not fit. Returns
+/// each table's (x, row) and the rows taken.
+fn pack_tables(cells: &[Table], width: u32, first_row: u32) -> (Vec<(u32, u32)>, u32) {
+    let (mut x, mut row) = (0, first_row);
+    let origins = cells
+        .iter()
+        .map(|table| {
+            let len = table.len() as u32 + 1;
+            if x + len > width {
+                (x, row) = (0, row + 1);
+            }
+            x += len;
+            (x - len, row)
+        })
+        .collect();
+    (origins, if cells.is_empty() { 0 } else { row + 1 - first_row })
 }
 
 /// The first global cell of coarse cell `i` of `coarse` along an axis of `cells` cells.
@@ -225,22 +252,26 @@ impl Product {
             }));
             clusters.push(table);
         }
-        let index = Product::build_index(d, coarse_columns, coarse_rows);
-        Product { grid, coarse_columns, coarse_rows, columns, rows, clusters, cells, ratio, index }
+        let width = table_width(&clusters, &cells);
+        let (origins, cell_rows) = pack_tables(&cells, width, clusters.len() as u32);
+        let index = Product::build_index(d, coarse_columns, coarse_rows, &origins);
+        Product { grid, coarse_columns, coarse_rows, columns, rows, clusters, cells, ratio, index, cell_rows }
     }
 
-    /// [`Product::index`] for the global tables `d` grouped into coarse cells.
-    fn build_index(d: &Distribution, coarse_columns: u32, coarse_rows: u32) -> Vec<u32> {
+    /// [`Product::index`] for the global tables `d` grouped into coarse cells whose tables
+    /// start at `origins` (x, row).
+    fn build_index(d: &Distribution, coarse_columns: u32, coarse_rows: u32, origins: &[(u32, u32)]) -> Vec<u32> {
         let (columns, rows) = (d.columns, d.rows);
         // The spans are packed in 16 bits: a side has at most MAX_CELLS cells.
         debug_assert!(columns <= MAX_CELLS && rows <= MAX_CELLS && MAX_CELLS < 1 << 16);
         let span = |i, coarse, cells| coarse_start(i, coarse, cells) | coarse_start(i + 1, coarse, cells) << 16;
-        let mut index = Vec::with_capacity((d.width + d.height + 2 * coarse_columns * coarse_rows) as usize);
+        let mut index = Vec::with_capacity((d.width + d.height + 3 * coarse_columns * coarse_rows) as usize);
         index.extend((0..d.width).map(|x| coarse_of(x / d.block_x, coarse_columns, columns)));
         index.extend((0..d.height).map(|y| coarse_of(y / d.block_y, coarse_rows, rows) * coarse_columns));
         for cr in 0..coarse_rows {
             for cc in 0..coarse_columns {
-                index.extend([span(cc, coarse_columns, columns), span(cr, coarse_rows, rows)]);
+                let (x, row) = origins[(cr * coarse_columns + cc) as usize];
+                index.extend([span(cc, coarse_columns, columns), span(cr, coarse_rows, rows), x | row << 16]);
             }
         }
         index
@@ -248,35 +279,49 @@ impl Product {
 
     /// Coarse cell `c`'s global cells: columns `c0 .. c1` and rows `r0 .. r1`, as (c0, c1, r0, r1).
     fn coarse_span(&self, d: &Distribution, c: u32) -> (u32, u32, u32, u32) {
-        let at = (d.width + d.height + 2 * c) as usize;
+        let at = (d.width + d.height + 3 * c) as usize;
         let (columns, rows) = (self.index[at], self.index[at + 1]);
         (columns & 0xffff, columns >> 16, rows & 0xffff, rows >> 16)
     }
 
-    /// The tables as `glsl/include/environment.glsl` reads them: two images of
-    /// `max(coarse cells, rows per coarse cell) + 1` texels across, the bucket entries (RGBA32F)
-    /// and the CDFs (R32F). Rows 0 .. clusters hold the clusters' tables, the next rows the
-    /// coarse cells' tables, and the CDF image's last `clusters` rows each cluster's ratios.
-    pub fn table_texels(&self) -> (u32, u32, Vec<[f32; 4]>, Vec<f32>) {
-        let tables = || self.clusters.iter().chain(&self.cells);
-        let width = tables().map(Table::len).max().unwrap_or(0) as u32 + 1;
-        let height = (tables().count() + self.clusters.len()) as u32;
-        let mut buckets = vec![[0.0f32; 4]; (width * height) as usize];
-        let mut cdfs = vec![0.0f32; (width * height) as usize];
-        for (row, table) in tables().enumerate() {
-            let start = row * width as usize;
+    /// Where coarse cell `c`'s table starts in the table images: (x, row).
+    pub fn cell_table_origin(&self, d: &Distribution, c: u32) -> (u32, u32) {
+        let origin = self.index[(d.width + d.height + 3 * c + 2) as usize];
+        (origin & 0xffff, origin >> 16)
+    }
+
+    /// The row of the CDF image that holds cluster 0's ratios; cluster k's is k rows below.
+    pub fn ratio_row(&self) -> u32 {
+        self.clusters.len() as u32 + self.cell_rows
+    }
+
+    /// The tables as `glsl/include/environment.glsl` reads them, two images
+    /// `max(coarse cells, rows per coarse cell) + 1` texels across: the bucket entries (RGBA32F,
+    /// `clusters + cell_rows` rows) and the CDFs (R32F, `clusters` more rows). Row k holds
+    /// cluster k's table, the next [`Product::cell_rows`] rows the coarse cells' tables where
+    /// [`Product::cell_table_origin`] says, and the CDF image's last rows each cluster's ratios,
+    /// from [`Product::ratio_row`]. Returns (width, bucket rows, CDF rows, buckets, CDFs).
+    pub fn table_texels(&self, d: &Distribution) -> (u32, u32, u32, Vec<[f32; 4]>, Vec<f32>) {
+        let width = table_width(&self.clusters, &self.cells);
+        let bucket_rows = self.ratio_row();
+        let cdf_rows = bucket_rows + self.clusters.len() as u32;
+        let mut buckets = vec![[0.0f32; 4]; (width * bucket_rows) as usize];
+        let mut cdfs = vec![0.0f32; (width * cdf_rows) as usize];
+        let origins = (0..self.clusters.len() as u32).map(|k| (0, k));
+        let cell_origins = (0..self.coarse_cells()).map(|c| self.cell_table_origin(d, c));
+        for ((x, row), table) in origins.chain(cell_origins).zip(self.clusters.iter().chain(&self.cells)) {
+            let start = (row * width + x) as usize;
             for (k, entry) in table.bucket_texels().enumerate() {
                 buckets[start + k] = entry;
             }
             cdfs[start..start + table.cdf.len()].copy_from_slice(&table.cdf);
         }
         let cells = self.coarse_cells() as usize;
-        let first = tables().count();
         for (k, ratios) in self.ratio.chunks(cells).enumerate() {
-            let start = (first + k) * width as usize;
+            let start = (bucket_rows as usize + k) * width as usize;
             cdfs[start..start + cells].copy_from_slice(ratios);
         }
-        (width, height, buckets, cdfs)
+        (width, bucket_rows, cdf_rows, buckets, cdfs)
     }
 
     /// The environment sample of `env_sample_mixture`: from `cluster`'s table with probability
@@ -368,6 +413,40 @@ mod tests {
                 previous = c;
             }
             assert_eq!(previous, coarse - 1);
+        }
+    }
+
+    /// The table images hold every table whole, each where the index says, none overlapping
+    /// another, and the coarse cells' short tables share rows.
+    #[test]
+    fn the_tables_are_packed_without_overlap() {
+        let blocked = Environment::new(45, 23, (0..45 * 23).map(|i| [(i % 11) as f32 + 0.5; 3]).collect(), "blocked");
+        for (env, max_cells) in [(sun_map(), 4096), (blocked, 7), (Environment::new(1, 1, vec![[0.5; 3]], "1x1"), 4096)]
+        {
+            let d = Distribution::compensated_with_max_cells(&env, max_cells);
+            let p = Product::build(&d);
+            let (width, bucket_rows, cdf_rows, buckets, cdfs) = p.table_texels(&d);
+            assert_eq!((bucket_rows, cdf_rows), (p.ratio_row(), p.ratio_row() + p.clusters.len() as u32));
+            assert_eq!((buckets.len(), cdfs.len()), ((width * bucket_rows) as usize, (width * cdf_rows) as usize));
+            let mut used = vec![false; (width * bucket_rows) as usize];
+            let cluster_origins = (0..p.clusters.len() as u32).map(|k| (0, k));
+            let cell_origins = (0..p.coarse_cells()).map(|c| p.cell_table_origin(&d, c));
+            for ((x, row), table) in cluster_origins.chain(cell_origins).zip(p.clusters.iter().chain(&p.cells)) {
+                let len = table.len() as u32 + 1;
+                assert!(x + len <= width && row < bucket_rows, "{}: a table runs off its image", env.source);
+                let start = (row * width + x) as usize;
+                assert_eq!(&cdfs[start..start + table.cdf.len()], &table.cdf[..], "{}", env.source);
+                for cell in &mut used[start..start + len as usize] {
+                    assert!(!*cell, "{}: two tables overlap at row {row}", env.source);
+                    *cell = true;
+                }
+            }
+            let longest = p.cells.iter().map(|t| t.len() as u32 + 1).max().unwrap_or(1);
+            assert!(p.cell_rows <= p.coarse_cells().div_ceil(width / longest), "{}: {} rows", env.source, p.cell_rows);
+            let ratios = &cdfs[(p.ratio_row() * width) as usize..];
+            for (k, row) in p.ratio.chunks(p.coarse_cells() as usize).enumerate() {
+                assert_eq!(&ratios[k * width as usize..][..row.len()], row, "{}: cluster {k}'s ratios", env.source);
+            }
         }
     }
 
@@ -528,8 +607,8 @@ mod tests {
         for (env, max_cells) in maps {
             let d = Distribution::compensated_with_max_cells(&env, max_cells);
             let p = Product::build(&d);
-            let (w, h, buckets, cdfs) = p.table_texels();
-            assert_eq!((buckets.len(), cdfs.len()), ((w * h) as usize, (w * h) as usize));
+            let (w, bucket_rows, cdf_rows, buckets, cdfs) = p.table_texels(&d);
+            assert_eq!((buckets.len(), cdfs.len()), ((w * bucket_rows) as usize, (w * cdf_rows) as usize));
             for cluster in 0..p.clusters.len() as u32 {
                 let mut total = 0.0;
                 for r in 0..d.rows {
