@@ -94,7 +94,6 @@ pub fn write_exr_with(
     let mut bytes = std::io::Cursor::new(Vec::new());
     Image::from_layer(layer)
         .write()
-        .non_parallel()
         .to_buffered(&mut bytes)
         .map_err(|e| Error::io(path, format!("cannot encode the EXR ({e})")))?;
     let mut bytes = bytes.into_inner();
