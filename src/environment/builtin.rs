@@ -88,10 +88,8 @@ impl Builtin {
         for v in texels.iter_mut().flatten() {
             *v = v.max(0.0);
         }
-        let mut environment = load::validate(width, height, texels, &name, &LoadOptions::default())
-            .expect("an embedded environment is valid");
-        environment.content_hash = self.content_hash();
-        environment
+        load::validate(width, height, texels, &name, &LoadOptions::default(), self.content_hash())
+            .expect("an embedded environment is valid")
     }
 }
 

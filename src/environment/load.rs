@@ -51,9 +51,7 @@ fn exr_environment(
     name: &str,
     options: &LoadOptions,
 ) -> Result<Environment> {
-    let mut environment = validate(width, height, texels, name, options)?;
-    environment.content_hash = super::content_hash(bytes);
-    Ok(environment)
+    validate(width, height, texels, name, options, super::content_hash(bytes))
 }
 
 /// The RGB texels of an EXR (a Y-only file is read as grey), before any checks.
@@ -119,9 +117,7 @@ pub fn from_hdr_bytes(bytes: &[u8], name: &str, options: &LoadOptions) -> Result
     let decoded = image::DynamicImage::from_decoder(decoder).map_err(unreadable)?.into_rgb32f();
     let (width, height) = decoded.dimensions();
     let texels = decoded.pixels().map(|p| p.0).collect();
-    let mut environment = validate(width, height, texels, name, options)?;
-    environment.content_hash = super::content_hash(bytes);
-    Ok(environment)
+    validate(width, height, texels, name, options, super::content_hash(bytes))
 }
 
 /// Refuses a Radiance header whose size the file cannot hold, before the decoder allocates it.
@@ -144,13 +140,15 @@ fn check_hdr_size((width, height): (u32, u32), file_bytes: u64) -> std::result::
     Ok(())
 }
 
-/// Checks the shape and the texels, fixing them only when the options allow.
+/// Checks the shape and the texels, fixing them only when the options allow. `content_hash` is
+/// the file's ([`super::content_hash`] of its bytes).
 pub fn validate(
     width: u32,
     height: u32,
     mut texels: Vec<[f32; 3]>,
     name: &str,
     options: &LoadOptions,
+    content_hash: u64,
 ) -> Result<Environment> {
     if width == 0 || height == 0 {
         return Err(Error::input_file(name, "the environment is empty"));
@@ -162,9 +160,17 @@ pub fn validate(
         ));
     }
     let bad = |v: f32| !(0.0..=MAX_TEXEL).contains(&v);
-    let count = |pred: &dyn Fn(f32) -> bool| texels.iter().filter(|t| t.iter().any(|&v| pred(v))).count();
-    let (nan, inf, negative) = (count(&|v| v.is_nan()), count(&|v| v.is_infinite()), count(&|v| v < 0.0));
-    let too_bright = count(&|v| v.is_finite() && v > MAX_TEXEL);
+    // One pass that counts the texels with a NaN, an infinite, a negative and a too bright
+    // value, and finds the largest value that is none of those (what an infinity becomes):
+    // start-up reads every texel of a map here, so one plain loop rather than five.
+    let (mut nan, mut inf, mut negative, mut too_bright, mut largest) = (0, 0, 0, 0, 0.0f32);
+    for texel in &texels {
+        nan += texel.iter().any(|v| v.is_nan()) as usize;
+        inf += texel.iter().any(|v| v.is_infinite()) as usize;
+        negative += texel.iter().any(|&v| v < 0.0) as usize;
+        too_bright += texel.iter().any(|&v| v.is_finite() && v > MAX_TEXEL) as usize;
+        largest = texel.iter().copied().filter(|&v| !bad(v)).fold(largest, f32::max);
+    }
     if nan + inf + negative + too_bright > 0 {
         let mut summary = format!("{nan} NaN, {inf} infinite and {negative} negative texels");
         if too_bright > 0 {
@@ -173,7 +179,6 @@ pub fn validate(
         if !options.clamp_invalid {
             return Err(Error::input_file(name, format!("the environment has {summary} (--env-clamp replaces them)")));
         }
-        let largest = texels.iter().flatten().copied().filter(|v| !bad(*v)).fold(0.0f32, f32::max);
         for texel in &mut texels {
             for v in texel.iter_mut().filter(|v| bad(**v)) {
                 *v = match *v {
@@ -185,5 +190,5 @@ pub fn validate(
         }
         crate::warn(format!("{name}: clamped {summary}"));
     }
-    Ok(Environment::new(width, height, texels, name))
+    Ok(Environment { width, height, texels, source: name.to_string(), content_hash })
 }

@@ -49,7 +49,8 @@ pub struct Environment {
     /// Where it came from, for messages: a path, or "built-in studio".
     pub source: String,
     /// FNV-1a (64-bit) of the file's bytes (of its texels, for one made in memory), recorded in
-    /// renders' metadata so that a render names the exact map that lit it.
+    /// renders' metadata so that a render names the exact map that lit it. It stands for the
+    /// texels: the sampling tables' cache is keyed by it, so texels are never changed after.
     pub content_hash: u64,
 }
 
