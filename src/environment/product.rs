@@ -416,15 +416,25 @@ mod tests {
         }
     }
 
+    /// Maps for the layout's tests: a sun, a map of blocked cells and a single texel, each with
+    /// its tables and product tables.
+    fn layout_cases() -> Vec<(Environment, Distribution, Product)> {
+        let blocked = Environment::new(45, 23, (0..45 * 23).map(|i| [(i % 11) as f32 + 0.5; 3]).collect(), "blocked");
+        [(sun_map(), 4096), (blocked, 7), (Environment::new(1, 1, vec![[0.5; 3]], "1x1"), 4096)]
+            .into_iter()
+            .map(|(env, max_cells)| {
+                let d = Distribution::compensated_with_max_cells(&env, max_cells);
+                let p = Product::build(&d);
+                (env, d, p)
+            })
+            .collect()
+    }
+
     /// The table images hold every table whole, each where the index says, none overlapping
     /// another, and the coarse cells' short tables share rows.
     #[test]
     fn the_tables_are_packed_without_overlap() {
-        let blocked = Environment::new(45, 23, (0..45 * 23).map(|i| [(i % 11) as f32 + 0.5; 3]).collect(), "blocked");
-        for (env, max_cells) in [(sun_map(), 4096), (blocked, 7), (Environment::new(1, 1, vec![[0.5; 3]], "1x1"), 4096)]
-        {
-            let d = Distribution::compensated_with_max_cells(&env, max_cells);
-            let p = Product::build(&d);
+        for (env, d, p) in layout_cases() {
             let (width, bucket_rows, cdf_rows, buckets, cdfs) = p.table_texels(&d);
             assert_eq!((bucket_rows, cdf_rows), (p.ratio_row(), p.ratio_row() + p.clusters.len() as u32));
             assert_eq!((buckets.len(), cdfs.len()), ((width * bucket_rows) as usize, (width * cdf_rows) as usize));
@@ -454,11 +464,7 @@ mod tests {
     /// the texel's cell, and the spans tile the grid.
     #[test]
     fn the_index_puts_each_texel_in_the_coarse_cell_that_spans_it() {
-        let blocked = Environment::new(45, 23, (0..45 * 23).map(|i| [(i % 11) as f32 + 0.5; 3]).collect(), "blocked");
-        for (env, max_cells) in [(sun_map(), 4096), (blocked, 7), (Environment::new(1, 1, vec![[0.5; 3]], "1x1"), 4096)]
-        {
-            let d = Distribution::compensated_with_max_cells(&env, max_cells);
-            let p = Product::build(&d);
+        for (env, d, p) in layout_cases() {
             let mut covered = vec![0u32; (d.columns * d.rows) as usize];
             for c in 0..p.coarse_cells() {
                 let (c0, c1, r0, r1) = p.coarse_span(&d, c);
