@@ -13,7 +13,7 @@ use crate::gpu::{Context, Image};
 use crate::material::params::Params;
 use crate::material::stack::{layer_weights, LayerWeight, PackedStacks};
 use crate::render::output::{self, OutputFormat};
-use crate::render::renderer::NoiseThreshold;
+use crate::render::renderer::{KernelSource, NoiseThreshold, Specialization};
 use crate::render::scene::covered_object_ids;
 use crate::render::{Lighting, Renderer};
 use crate::shading::model::Model;
@@ -166,8 +166,15 @@ impl Session {
         let masks: Vec<String> = gbuffer.masks.keys().cloned().collect();
         let packed = PackedStacks::pack(document.look(), objects.iter().copied(), &gbuffer, &gbuffer_name)?;
         let settings = document.settings().clone();
-        let mut renderer = Renderer::with_model(ctx, &gbuffer, &environment, &settings.model)?;
-        renderer.set_sampling(settings.sampling, &environment)?;
+        // Made for the look's estimator and lobes, so that neither set_stacks nor set_sampling
+        // compiles the relight kernel again.
+        let kernels = KernelSource::Compile(Specialization {
+            model: settings.model,
+            product: settings.sampling.product_kernel(),
+            lobes: packed.lobes(),
+            ..Specialization::default()
+        });
+        let mut renderer = Renderer::with_kernels(ctx, &gbuffer, &environment, settings.sampling, kernels)?;
         renderer.set_stacks(&packed)?;
         renderer.set_lighting(settings.lighting);
         renderer.set_seed(settings.seed);
