@@ -8,8 +8,10 @@ mod common;
 
 use common::scenes::{look, orthographic_sphere, renderer};
 use lookdev::environment::Environment;
-use lookdev::material::stack::LobesPresent;
+use lookdev::gpu::inject::{fail_at, Step};
+use lookdev::material::stack::{LobesPresent, PackedStacks};
 use lookdev::render::{Lighting, Renderer};
+use std::path::Path;
 
 /// A layer that changes no pixel and has every lobe.
 const HIDDEN_LAYER: &str = "[[object.layer]]\nopacity = 0.0\n[object.layer.set]\nmetallic = 0.0\nclearcoat = 1.0\n";
@@ -57,5 +59,33 @@ fn a_kernel_without_absent_lobes_renders_what_one_with_every_lobe_renders() {
         }
         assert!(lit > 100, "{material}: the sphere is lit ({lit} pixels)");
     }
+    common::gpu::finish(ctx);
+}
+
+/// New stacks that need another specialisation, which the driver refuses, leave the renderer
+/// as it was: the same kernel, lobes and stacks, rendering the same image.
+#[test]
+fn a_refused_respecialisation_leaves_the_renderer_as_it_was() {
+    let ctx = common::gpu::context();
+    let env = Environment::default_builtin();
+    let gbuffer = orthographic_sphere(24);
+    let gold = "[[object]]\n[[object.layer]]\npreset = \"gold\"\n";
+    let mut r = renderer(&ctx, &gbuffer, &env, &look(gold), Lighting::default());
+    let before = render(&mut r, 4);
+    // A rougher gold under a coat: the stacks change what every pixel shows, beside the lobes.
+    let coated = look(&format!("{gold}[object.layer.set]\nclearcoat = 1.0\nroughness = 0.6\n"));
+    let ids = lookdev::render::scene::covered_object_ids(&gbuffer);
+    let coated = PackedStacks::pack(&coated, ids, &gbuffer, Path::new("test g-buffer")).unwrap();
+    {
+        let fail = fail_at(Step::Pipeline);
+        assert!(r.set_stacks(&coated).is_err(), "the refused pipeline is an error");
+        assert!(fail.reached());
+    }
+    assert_eq!(r.lobes(), LobesPresent { diffuse: false, clearcoat: false });
+    r.restart();
+    let after = render(&mut r, 4);
+    let bits = |p: &[[f32; 4]]| p.iter().map(|v| v.map(f32::to_bits)).collect::<Vec<_>>();
+    assert!(bits(&after) == bits(&before), "the same image, bit for bit");
+    drop(r);
     common::gpu::finish(ctx);
 }

@@ -357,24 +357,30 @@ impl Renderer {
     }
 
     /// Uploads new layer stacks and resolves them into one material per pixel (once per edit,
-    /// not per sample). Accumulation restarts, and the relight kernel is respecialised if the
-    /// stacks have other lobes ([`PackedStacks::lobes`]).
+    /// not per sample). Accumulation restarts, and the relight kernel is respecialised first if
+    /// the stacks have other lobes ([`PackedStacks::lobes`]): a kernel the driver refuses
+    /// leaves the renderer as it was.
     pub fn set_stacks(&mut self, packed: &PackedStacks) -> Result<()> {
+        self.set_lobes(packed.lobes())?;
         self.resolve.set_stacks(&self.ctx, &mut self.gbuffer, packed, &self.targets)?;
         let (width, height) = (self.width, self.height);
         self.timed(|renderer, cmd| renderer.resolve.record(cmd, width, height))?;
-        self.set_lobes(packed.lobes())?;
         self.restart();
         Ok(())
     }
 
-    /// Specialises the relight kernel for `lobes`, restarting accumulation, unless it is.
+    /// Specialises the relight kernel for `lobes` and restarts accumulation, unless it already
+    /// is specialised for them. Returns whether it was respecialised; if that fails, the kernel
+    /// and the lobes it is for stay as they were.
     fn set_lobes(&mut self, lobes: LobesPresent) -> Result<bool> {
         if lobes == self.lobes {
             return Ok(false);
         }
-        self.lobes = lobes;
-        self.respecialize(self.relight.shading.model, self.relight.accumulate)?;
+        let previous = std::mem::replace(&mut self.lobes, lobes);
+        if let Err(e) = self.respecialize(self.relight.shading.model, self.relight.accumulate) {
+            self.lobes = previous;
+            return Err(e);
+        }
         Ok(true)
     }
 
@@ -791,11 +797,12 @@ impl Renderer {
     /// another specialisation of the relight kernel ([`PackedStacks::lobes`]): then everything
     /// restarts, as with [`Renderer::set_stacks`], and this returns None.
     pub fn set_stacks_local(&mut self, packed: &PackedStacks) -> Result<Option<usize>> {
+        let respecialised = self.set_lobes(packed.lobes())?;
         self.resolve.set_stacks(&self.ctx, &mut self.gbuffer, packed, &self.targets)?;
         let (width, height) = (self.width, self.height);
         self.timed(|renderer, cmd| renderer.resolve.record(cmd, width, height))?;
         let changed = self.resolve.changed_pixels(width as usize * height as usize)?;
-        if self.set_lobes(packed.lobes())? {
+        if respecialised {
             return Ok(None);
         }
         self.restart_pixels(&changed);
