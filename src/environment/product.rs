@@ -279,15 +279,20 @@ impl Product {
 
     /// Coarse cell `c`'s global cells: columns `c0 .. c1` and rows `r0 .. r1`, as (c0, c1, r0, r1).
     fn coarse_span(&self, d: &Distribution, c: u32) -> (u32, u32, u32, u32) {
-        let at = (d.width + d.height + 3 * c) as usize;
-        let (columns, rows) = (self.index[at], self.index[at + 1]);
+        let [columns, rows, _] = self.cell_words(d, c);
         (columns & 0xffff, columns >> 16, rows & 0xffff, rows >> 16)
     }
 
     /// Where coarse cell `c`'s table starts in the table images: (x, row).
     pub fn cell_table_origin(&self, d: &Distribution, c: u32) -> (u32, u32) {
-        let origin = self.index[(d.width + d.height + 3 * c + 2) as usize];
+        let [_, _, origin] = self.cell_words(d, c);
         (origin & 0xffff, origin >> 16)
+    }
+
+    /// Coarse cell `c`'s three words of [`Product::index`].
+    fn cell_words(&self, d: &Distribution, c: u32) -> [u32; 3] {
+        let at = (d.width + d.height + 3 * c) as usize;
+        [self.index[at], self.index[at + 1], self.index[at + 2]]
     }
 
     /// The row of the CDF image that holds cluster 0's ratios; cluster k's is k rows below.
