@@ -11,7 +11,7 @@ use common::scenes::{one_material, orthographic_sphere, renderer};
 use common::stats::chi_square;
 use glam::{Vec2, Vec3};
 use lookdev::environment::product::{cluster_of, Product, GRID};
-use lookdev::environment::{sampling, Builtin, Distribution, Environment, GpuEnvironment};
+use lookdev::environment::{sampling, Builtin, Distribution, Environment, GpuEnvironment, Samplers};
 use lookdev::gpu::Context;
 use lookdev::material::Params;
 use lookdev::render::renderer::Accumulate;
@@ -33,7 +33,9 @@ fn gpu_product_samples(
     q: f32,
     u: &[Vec2],
 ) -> Vec<(Vec3, f32)> {
-    let gpu_env = GpuEnvironment::upload_with(ctx, env, d, Some(product)).unwrap();
+    // The cluster's sampler alone (q = 1) runs without the global bucket entries.
+    let samplers = if q == 1.0 { Samplers::Product(product) } else { Samplers::Mixture(product) };
+    let gpu_env = GpuEnvironment::upload_with(ctx, env, d, samplers).unwrap();
     environment_samples(ctx, &gpu_env, PRODUCT, cluster, q, u)
 }
 

@@ -260,32 +260,48 @@ impl Distribution {
         [self.width, self.height, self.block_x, self.block_y, self.columns, self.rows, 0, 0]
     }
 
-    /// The cell pdf_ω of every texel, row-major: what the GPU stores beside the radiance.
-    pub fn texel_pdf(&self) -> Vec<f32> {
-        let mut out = Vec::with_capacity((self.width * self.height) as usize);
-        for y in 0..self.height {
-            for x in 0..self.width {
-                out.push(self.cell_pdf[((y / self.block_y) * self.columns + x / self.block_x) as usize]);
+    /// Writes the texels as the GPU stores them, row-major: each one's radiance from `env`, and
+    /// its cell's pdf_ω in a, so that one fetch gives both.
+    pub fn write_texels(&self, env: &Environment, out: &mut [[f32; 4]]) {
+        for (y, (texels, row)) in
+            env.texels.chunks(self.width as usize).zip(out.chunks_mut(self.width as usize)).enumerate()
+        {
+            let pdfs = &self.cell_pdf[(y as u32 / self.block_y * self.columns) as usize..];
+            for (x, (t, texel)) in texels.iter().zip(row).enumerate() {
+                *texel = [t[0], t[1], t[2], pdfs[x / self.block_x as usize]];
             }
         }
-        out
     }
 
-    /// The tables as two images of `max(rows, columns) + 1` by `rows + 1` texels: the bucket
-    /// entries (RGBA32F) and the plain CDFs (R32F). Row 0 is the marginal table, row 1 + r the
-    /// conditional table of row r.
-    pub fn table_texels(&self) -> (u32, u32, Vec<[f32; 4]>, Vec<f32>) {
-        let width = self.rows.max(self.columns) + 1;
-        let mut buckets = vec![[0.0f32; 4]; (width * (self.rows + 1)) as usize];
-        let mut cdfs = vec![0.0f32; (width * (self.rows + 1)) as usize];
-        for (row, table) in std::iter::once(&self.marginal).chain(&self.conditional).enumerate() {
-            let start = row * width as usize;
-            for (k, entry) in table.bucket_texels().enumerate() {
-                buckets[start + k] = entry;
+    /// The size of the table images: `max(rows, columns) + 1` by `rows + 1` texels. Row 0 holds
+    /// the marginal table, row 1 + r the conditional table of row r.
+    pub fn table_size(&self) -> (u32, u32) {
+        (self.rows.max(self.columns) + 1, self.rows + 1)
+    }
+
+    /// The marginal and conditional tables, in [`Distribution::table_size`] order.
+    fn tables(&self) -> impl Iterator<Item = &Table> {
+        std::iter::once(&self.marginal).chain(&self.conditional)
+    }
+
+    /// Writes the bucket entries of the tables (an RGBA32F image of [`Distribution::table_size`]).
+    pub fn write_buckets(&self, out: &mut [[f32; 4]]) {
+        let (width, _) = self.table_size();
+        for (row, table) in out.chunks_mut(width as usize).zip(self.tables()) {
+            row.fill([0.0; 4]);
+            for (texel, entry) in row.iter_mut().zip(table.bucket_texels()) {
+                *texel = entry;
             }
-            cdfs[start..start + table.cdf.len()].copy_from_slice(&table.cdf);
         }
-        (width, self.rows + 1, buckets, cdfs)
+    }
+
+    /// Writes the plain CDFs of the tables (an R32F image of [`Distribution::table_size`]).
+    pub fn write_cdfs(&self, out: &mut [f32]) {
+        let (width, _) = self.table_size();
+        for (row, table) in out.chunks_mut(width as usize).zip(self.tables()) {
+            row.fill(0.0);
+            row[..table.cdf.len()].copy_from_slice(&table.cdf);
+        }
     }
 }
 
@@ -344,7 +360,7 @@ mod tests {
     fn a_small_device_limit_shrinks_the_grid_to_fit() {
         let env = Environment::new(64, 32, vec![[1.0; 3]; 64 * 32], "x");
         let d = Distribution::for_device(&env, 33);
-        let (width, height, _, _) = d.table_texels();
+        let (width, height) = d.table_size();
         assert!(width <= 33 && height <= 33, "{width}x{height}");
     }
 

@@ -13,22 +13,39 @@ pub struct GpuEnvironment {
     pub buckets: Image,
     pub cdf: Image,
     pub info: Buffer,
-    /// The product tables (`env_product_buckets`, `env_product_cdf`), or 1×1 placeholders.
+    /// The product tables (`env_product_buckets`, `env_product_cdf`), or 1×1 placeholders;
+    /// `buckets` is one too when only the product sampler runs ([`Samplers::Product`]).
     pub product_buckets: Image,
     pub product_cdf: Image,
 }
 
+/// The environment samplers the kernels bound to an environment run, which decide the tables
+/// it needs.
+#[derive(Clone, Copy)]
+pub enum Samplers<'a> {
+    /// The global tables' (`env_sample`).
+    Global,
+    /// A cluster's product tables alone (`env_sample_cluster`: the relight kernel's with
+    /// product sampling). They refine the global CDFs, but never read the global bucket
+    /// entries, which are left out (a 1×1 placeholder).
+    Product(&'a Product),
+    /// Both, and their mixture (`env_sample_mixture`).
+    Mixture(&'a Product),
+}
+
 impl GpuEnvironment {
     pub fn upload(ctx: &Context, env: &Environment, distribution: &Distribution) -> Result<GpuEnvironment> {
-        GpuEnvironment::upload_with(ctx, env, distribution, None)
+        GpuEnvironment::upload_with(ctx, env, distribution, Samplers::Global)
     }
 
-    /// As [`GpuEnvironment::upload`], with product tables built from `distribution` when given.
+    /// As [`GpuEnvironment::upload`], with the tables `samplers` need, built from
+    /// `distribution`. Each image's texels are written straight into the memory its upload
+    /// copies from.
     pub fn upload_with(
         ctx: &Context,
         env: &Environment,
         distribution: &Distribution,
-        product: Option<&Product>,
+        samplers: Samplers,
     ) -> Result<GpuEnvironment> {
         let max = ctx.info().max_image_dimension_2d;
         if env.width > max || env.height > max {
@@ -37,31 +54,36 @@ impl GpuEnvironment {
                 format!("the environment is {}x{}, larger than this device's {max} pixel limit", env.width, env.height),
             ));
         }
-        let texels = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, env.width, env.height, 1, false)?;
-        let rgba: Vec<[f32; 4]> =
-            env.texels.iter().zip(distribution.texel_pdf()).map(|(t, pdf)| [t[0], t[1], t[2], pdf]).collect();
-        texels.upload(ctx, bytemuck::cast_slice(&rgba))?;
-        let (width, height, bucket_texels, cdf_texels) = distribution.table_texels();
-        let buckets = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 1, false)?;
-        buckets.upload(ctx, bytemuck::cast_slice(&bucket_texels))?;
-        let cdf = Image::new(ctx, vk::Format::R32_SFLOAT, width, height, 1, false)?;
-        cdf.upload(ctx, bytemuck::cast_slice(&cdf_texels))?;
-        let (width, bucket_rows, cdf_rows, bucket_texels, cdf_texels) = match product {
-            Some(p) => p.table_texels(distribution),
-            None => (1, 1, 1, vec![[0.0; 4]], vec![0.0]),
+        let (rgba, r32) = (vk::Format::R32G32B32A32_SFLOAT, vk::Format::R32_SFLOAT);
+        let texels = Image::filled(ctx, rgba, env.width, env.height, |out| distribution.write_texels(env, out))?;
+        let (width, height) = distribution.table_size();
+        let buckets = match samplers {
+            Samplers::Product(_) => placeholder(ctx, rgba)?,
+            _ => Image::filled(ctx, rgba, width, height, |out| distribution.write_buckets(out))?,
         };
-        if width > max || cdf_rows > max {
-            return Err(Error::input_file(
-                &env.source,
-                format!(
-                    "its product tables need {width}x{cdf_rows} images, larger than this device's {max} pixel limit"
-                ),
-            ));
-        }
-        let product_buckets = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, bucket_rows, 1, false)?;
-        product_buckets.upload(ctx, bytemuck::cast_slice(&bucket_texels))?;
-        let product_cdf = Image::new(ctx, vk::Format::R32_SFLOAT, width, cdf_rows, 1, false)?;
-        product_cdf.upload(ctx, bytemuck::cast_slice(&cdf_texels))?;
+        let cdf = Image::filled(ctx, r32, width, height, |out| distribution.write_cdfs(out))?;
+        let product = match samplers {
+            Samplers::Global => None,
+            Samplers::Product(p) | Samplers::Mixture(p) => Some(p),
+        };
+        let (product_buckets, product_cdf) = match product {
+            Some(p) => {
+                let (width, bucket_rows, cdf_rows) = p.table_size();
+                if width > max || cdf_rows > max {
+                    return Err(Error::input_file(
+                        &env.source,
+                        format!(
+                            "its product tables need {width}x{cdf_rows} images, larger than this device's {max} pixel limit"
+                        ),
+                    ));
+                }
+                (
+                    Image::filled(ctx, rgba, width, bucket_rows, |out| p.write_buckets(distribution, out))?,
+                    Image::filled(ctx, r32, width, cdf_rows, |out| p.write_cdfs(distribution, out))?,
+                )
+            }
+            None => (placeholder(ctx, rgba)?, placeholder(ctx, r32)?),
+        };
         // EnvInfo: the header, then env_product_index (one unused word when off, as a buffer
         // may not be empty).
         let mut info = vec![0u32; 10];
@@ -88,6 +110,11 @@ impl GpuEnvironment {
             Binding::Image(&self.product_cdf),
         ]
     }
+}
+
+/// A 1×1 image of zeros bound where a table is not needed.
+fn placeholder(ctx: &Context, format: vk::Format) -> Result<Image> {
+    Image::new(ctx, format, 1, 1, 1, false)
 }
 
 /// The layout of descriptor set 1.

@@ -17,7 +17,7 @@ pub mod sampling;
 
 pub use builtin::{Builtin, EnvironmentRef};
 pub use distribution::Distribution;
-pub use gpu::GpuEnvironment;
+pub use gpu::{GpuEnvironment, Samplers};
 pub use load::LoadOptions;
 
 /// The brightest texel an environment may hold. With [`MAX_INTENSITY`], radiance stays below

@@ -300,32 +300,60 @@ impl Product {
         self.clusters.len() as u32 + self.cell_rows
     }
 
-    /// The tables as `glsl/include/environment.glsl` reads them, two images
-    /// `max(coarse cells, rows per coarse cell) + 1` texels across: the bucket entries (RGBA32F,
-    /// `clusters + cell_rows` rows) and the CDFs (R32F, `clusters` more rows). Row k holds
-    /// cluster k's table, the next [`Product::cell_rows`] rows the coarse cells' tables where
-    /// [`Product::cell_table_origin`] says, and the CDF image's last rows each cluster's ratios,
-    /// from [`Product::ratio_row`]. Returns (width, bucket rows, CDF rows, buckets, CDFs).
-    pub fn table_texels(&self, d: &Distribution) -> (u32, u32, u32, Vec<[f32; 4]>, Vec<f32>) {
-        let width = table_width(&self.clusters, &self.cells);
+    /// The size of the table images as `glsl/include/environment.glsl` reads them:
+    /// `max(coarse cells, rows per coarse cell) + 1` texels across, [`Product::ratio_row`] rows
+    /// of bucket entries (RGBA32F) and `clusters` more of CDFs (R32F). Row k holds cluster k's
+    /// table, the next [`Product::cell_rows`] rows the coarse cells' tables where
+    /// [`Product::cell_table_origin`] says, and the CDF image's last rows each cluster's ratios.
+    /// Returns (width, bucket rows, CDF rows).
+    pub fn table_size(&self) -> (u32, u32, u32) {
         let bucket_rows = self.ratio_row();
-        let cdf_rows = bucket_rows + self.clusters.len() as u32;
-        let mut buckets = vec![[0.0f32; 4]; (width * bucket_rows) as usize];
-        let mut cdfs = vec![0.0f32; (width * cdf_rows) as usize];
+        (table_width(&self.clusters, &self.cells), bucket_rows, bucket_rows + self.clusters.len() as u32)
+    }
+
+    /// Every table with where it starts in the table images, (x, row): the clusters', then the
+    /// coarse cells'.
+    fn placed_tables<'a>(&'a self, d: &'a Distribution) -> impl Iterator<Item = ((u32, u32), &'a Table)> {
         let origins = (0..self.clusters.len() as u32).map(|k| (0, k));
         let cell_origins = (0..self.coarse_cells()).map(|c| self.cell_table_origin(d, c));
-        for ((x, row), table) in origins.chain(cell_origins).zip(self.clusters.iter().chain(&self.cells)) {
+        origins.chain(cell_origins).zip(self.clusters.iter().chain(&self.cells))
+    }
+
+    /// Writes the bucket image (of [`Product::table_size`]).
+    pub fn write_buckets(&self, d: &Distribution, out: &mut [[f32; 4]]) {
+        let (width, _, _) = self.table_size();
+        out.fill([0.0; 4]);
+        for ((x, row), table) in self.placed_tables(d) {
             let start = (row * width + x) as usize;
-            for (k, entry) in table.bucket_texels().enumerate() {
-                buckets[start + k] = entry;
+            for (texel, entry) in out[start..].iter_mut().zip(table.bucket_texels()) {
+                *texel = entry;
             }
-            cdfs[start..start + table.cdf.len()].copy_from_slice(&table.cdf);
+        }
+    }
+
+    /// Writes the CDF image (of [`Product::table_size`]): the tables' CDFs, then the ratios.
+    pub fn write_cdfs(&self, d: &Distribution, out: &mut [f32]) {
+        let (width, bucket_rows, _) = self.table_size();
+        out.fill(0.0);
+        for ((x, row), table) in self.placed_tables(d) {
+            let start = (row * width + x) as usize;
+            out[start..start + table.cdf.len()].copy_from_slice(&table.cdf);
         }
         let cells = self.coarse_cells() as usize;
         for (k, ratios) in self.ratio.chunks(cells).enumerate() {
             let start = (bucket_rows as usize + k) * width as usize;
-            cdfs[start..start + cells].copy_from_slice(ratios);
+            out[start..start + cells].copy_from_slice(ratios);
         }
+    }
+
+    /// The two table images' texels, for tests: (width, bucket rows, CDF rows, buckets, CDFs).
+    #[cfg(test)]
+    fn table_texels(&self, d: &Distribution) -> (u32, u32, u32, Vec<[f32; 4]>, Vec<f32>) {
+        let (width, bucket_rows, cdf_rows) = self.table_size();
+        let mut buckets = vec![[1.0f32; 4]; (width * bucket_rows) as usize];
+        let mut cdfs = vec![1.0f32; (width * cdf_rows) as usize];
+        self.write_buckets(d, &mut buckets);
+        self.write_cdfs(d, &mut cdfs);
         (width, bucket_rows, cdf_rows, buckets, cdfs)
     }
 

@@ -150,6 +150,8 @@ impl Drop for Buffer {
 enum Purpose {
     /// Read and written by kernels, filled and read back by transfers.
     Storage,
+    /// Read by kernels, filled by a transfer as soon as it is made.
+    Filled,
     /// RGBA8 display pixels that kernels write and the viewer samples as sRGB.
     Display,
     /// A colour target of the bake's render pass, read back by transfers.
@@ -164,7 +166,7 @@ impl Purpose {
     fn usage(self) -> vk::ImageUsageFlags {
         let transfer = vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
         match self {
-            Purpose::Storage => vk::ImageUsageFlags::STORAGE | transfer,
+            Purpose::Storage | Purpose::Filled => vk::ImageUsageFlags::STORAGE | transfer,
             Purpose::Display => vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::SAMPLED | transfer,
             Purpose::ColorTarget => vk::ImageUsageFlags::COLOR_ATTACHMENT | transfer,
             Purpose::DepthTarget => vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
@@ -172,8 +174,8 @@ impl Purpose {
         }
     }
 
-    /// Whether a new image is cleared: all but textures (filled at once) and depth buffers
-    /// (cleared by their render pass).
+    /// Whether a new image is cleared: all but those filled at once and depth buffers (cleared
+    /// by their render pass).
     fn cleared_on_creation(self) -> bool {
         matches!(self, Purpose::Storage | Purpose::Display | Purpose::ColorTarget)
     }
@@ -221,6 +223,20 @@ impl Image {
     /// A storage image of `layers` layers (a 2D array view when `layers` > 1 or `array` is set).
     pub fn new(ctx: &Context, format: vk::Format, width: u32, height: u32, layers: u32, array: bool) -> Result<Image> {
         Image::create(ctx, format, width, height, layers, array, Purpose::Storage, 1)
+    }
+
+    /// A storage image of one layer whose texels `fill` writes, row-major, straight into the
+    /// memory the transfer copies from: no other copy of them is made on the host.
+    pub fn filled<T: bytemuck::Pod>(
+        ctx: &Context,
+        format: vk::Format,
+        width: u32,
+        height: u32,
+        fill: impl FnOnce(&mut [T]),
+    ) -> Result<Image> {
+        let image = Image::create(ctx, format, width, height, 1, false, Purpose::Filled, 1)?;
+        image.upload_with(ctx, |bytes| fill(bytemuck::cast_slice_mut(bytes)))?;
+        Ok(image)
     }
 
     /// An RGBA8 storage image holding sRGB-encoded display pixels, which can also be sampled
@@ -399,8 +415,14 @@ impl Image {
     /// Fills every layer from tightly packed texels, layer after layer, rows top to bottom.
     pub fn upload(&self, ctx: &Context, data: &[u8]) -> Result<()> {
         assert_eq!(data.len() as u64, self.byte_size(), "upload size must match the image");
+        self.upload_with(ctx, |bytes| bytes.copy_from_slice(data))
+    }
+
+    /// Fills every layer with the texels `fill` writes into the staging memory, laid out as
+    /// for [`Image::upload`].
+    fn upload_with(&self, ctx: &Context, fill: impl FnOnce(&mut [u8])) -> Result<()> {
         let mut staging = Buffer::staging(ctx, self.byte_size())?;
-        staging.bytes_mut()[..data.len()].copy_from_slice(data);
+        fill(&mut staging.bytes_mut()[..self.byte_size() as usize]);
         self.copy_from(ctx, &staging, &[self.copy_region()])
     }
 

@@ -7,7 +7,7 @@ use super::passes::pixel_lists::{PixelLists, RowList};
 use super::passes::relight::{RelightPass, Source};
 use super::passes::resolve::ResolvePass;
 use super::passes::Targets;
-use crate::environment::{Environment, GpuEnvironment};
+use crate::environment::{Environment, GpuEnvironment, Samplers};
 use crate::gbuffer::gpu::GpuGBuffer;
 use crate::gbuffer::GBuffer;
 use crate::gpu::{Buffer, Context, GpuTimer, Image};
@@ -813,7 +813,9 @@ impl Renderer {
 /// An environment with the sampling tables `sampling` uses, on the GPU.
 fn upload_environment(ctx: &Context, environment: &Environment, sampling: Sampling) -> Result<GpuEnvironment> {
     let distribution = sampling.distribution(environment, ctx.info().max_image_dimension_2d);
-    GpuEnvironment::upload_with(ctx, environment, &distribution, sampling.product(&distribution).as_ref())
+    let product = sampling.product(&distribution);
+    let samplers = product.as_ref().map_or(Samplers::Global, Samplers::Product);
+    GpuEnvironment::upload_with(ctx, environment, &distribution, samplers)
 }
 
 /// Pixels restarted alone, catching up with their rows.
