@@ -9,6 +9,19 @@ use std::time::{Duration, Instant};
 /// progress bar and well below any driver watchdog.
 const TARGET_DISPATCH: Duration = Duration::from_millis(500);
 
+/// The slowest speed assumed of a device, in samples a second, to size the first dispatch:
+/// about a quarter of lavapipe's on two cores. The first dispatch of a small image then holds
+/// several samples, so that a short render takes two dispatches rather than four, each of
+/// which pays the per-pixel set-up again.
+const MIN_SPEED: f64 = 5e6;
+
+/// Samples per pixel of the first dispatch over `pixels` pixels: what [`MIN_SPEED`] does in
+/// an eighth of [`TARGET_DISPATCH`], at least 1 and at most `spp`.
+fn first_batch(pixels: usize, spp: u32) -> u32 {
+    let samples = MIN_SPEED * (TARGET_DISPATCH / 8).as_secs_f64() / pixels.max(1) as f64;
+    (samples as u32).clamp(1, spp.max(1))
+}
+
 /// What a progressive render measured.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct RenderStats {
@@ -27,7 +40,11 @@ pub struct RenderStats {
 pub fn accumulate(renderer: &mut Renderer, spp: u32, mut progress: impl FnMut(u32)) -> Result<RenderStats> {
     let start = Instant::now();
     let mut stats = RenderStats::default();
-    let mut batch = 1u32;
+    let mut batch = first_batch(renderer.covered_pixels(), spp);
+    if let Some(noise) = renderer.noise_threshold() {
+        // No pixel stops before its minimum: a render whose pixels all stop there ends there.
+        batch = batch.min(noise.min_samples.max(1));
+    }
     while renderer.samples() < spp && renderer.active_pixels() != Some(0) {
         let count = batch.min(spp - renderer.samples());
         let dispatch_start = Instant::now();
@@ -40,10 +57,14 @@ pub fn accumulate(renderer: &mut Renderer, spp: u32, mut progress: impl FnMut(u3
             _ => None,
         };
         progress(renderer.samples());
-        // Grow the batch while dispatches stay under the target. A pass costs a fixed set-up
-        // plus a cost per sample, so the time per sample of a small batch overstates that of a
-        // large one: growing geometrically, rather than by extrapolating, still gets there.
-        if elapsed < TARGET_DISPATCH / 8 {
+        // A pass costs a fixed set-up plus a cost per sample, so the time per sample of a small
+        // batch overstates that of a large one: the rest goes in one dispatch once this one's
+        // pace says it would take less than the target, and otherwise the batch grows
+        // geometrically rather than by extrapolating.
+        let remaining = spp.saturating_sub(renderer.samples());
+        if elapsed.mul_f64(remaining as f64 / count as f64) < TARGET_DISPATCH {
+            batch = remaining.max(1);
+        } else if elapsed < TARGET_DISPATCH / 8 {
             batch = batch.saturating_mul(4);
         } else if elapsed < TARGET_DISPATCH / 2 {
             batch = batch.saturating_mul(2);
@@ -57,4 +78,22 @@ pub fn accumulate(renderer: &mut Renderer, spp: u32, mut progress: impl FnMut(u3
         stats.mean_spp = Some(counts.iter().map(|&n| n as f64).sum::<f64>() / renderer.covered_pixels() as f64);
     }
     Ok(stats)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_first_dispatch_holds_what_a_slow_device_does_in_an_eighth_of_the_target() {
+        // The 256² sphere's 42208 covered pixels: 7 samples, 0.3 M in all.
+        assert_eq!(first_batch(42_208, 64), 7);
+        // A 1080p frame mostly covered, or more pixels than a slow device does in that time: 1.
+        assert_eq!(first_batch(1_500_000, 64), 1);
+        assert_eq!(first_batch(400_000, 64), 1);
+        // Never more than the render asks for, nor less than one.
+        assert_eq!(first_batch(100, 16), 16);
+        assert_eq!(first_batch(0, 4), 4);
+        assert_eq!(first_batch(100, 0), 1);
+    }
 }
