@@ -75,7 +75,7 @@ impl AdaptiveArgs {
 struct Rendered {
     width: u32,
     height: u32,
-    /// Display pixels, RGBA8 sRGB, after exposure and the tone map.
+    /// Display pixels, RGBA8 sRGB, after exposure and the tone map; empty unless asked for.
     display: Vec<u8>,
     /// Linear radiance, for EXR output.
     radiance: Option<Vec<[f32; 4]>>,
@@ -85,12 +85,14 @@ struct Rendered {
 }
 
 /// Relights `scene` on `ctx` with `kernels` (specialised for the settings and `aovs`, see
-/// [`kernels_for`]) and reads back what the output needs, with the AOVs `aovs`.
+/// [`kernels_for`]) and reads back what the output needs: the radiance, the AOVs `aovs`, and
+/// the display pixels when `display` is set.
 fn render(
     ctx: &Context,
     scene: &Scene,
     kernels: KernelSource,
     aovs: &[Aov],
+    display: bool,
     label: &str,
     quiet: bool,
 ) -> Result<Rendered> {
@@ -115,7 +117,7 @@ fn render(
     Ok(Rendered {
         width: renderer.width,
         height: renderer.height,
-        display: renderer.read_display(settings.exposure, settings.tonemap)?,
+        display: if display { renderer.read_display(settings.exposure, settings.tonemap)? } else { Vec::new() },
         radiance: Some(renderer.read_radiance()?),
         aovs: aov::layers(aovs, &sources)?,
         stats,
@@ -144,7 +146,10 @@ pub fn run(args: RenderArgs) -> Result<()> {
         let counter = ctx.validation_counter();
         let device_name = ctx.info().name.clone();
         let aovs = output_aovs(format, display, &scene.settings);
-        let rendered = render(&ctx, &scene, KernelSource::Pending(kernels), &aovs, "rendering", args.quiet)?;
+        // Only a PNG of the beauty shows the display pixels.
+        let beauty_png = format == OutputFormat::Png && display.is_none();
+        let rendered =
+            render(&ctx, &scene, KernelSource::Pending(kernels), &aovs, beauty_png, "rendering", args.quiet)?;
         drop(ctx);
         super::check_validation(&counter)?;
         Ok((scene, rendered, device_name))
@@ -289,12 +294,12 @@ fn run_compare(args: &RenderArgs, format: OutputFormat, second_look: Option<&Pat
     let counter = ctx.validation_counter();
     let device_name = ctx.info().name.clone();
     let kernels = |scene: &Scene| KernelSource::Compile(kernels_for(scene, &[]));
-    let first = render(&ctx, &a, kernels(&a), &[], "rendering A", args.quiet)?;
+    let first = render(&ctx, &a, kernels(&a), &[], true, "rendering A", args.quiet)?;
     let second = match second_scene {
-        Second::Look(b) => render(&ctx, &b, kernels(&b), &[], "rendering B", args.quiet)?,
+        Second::Look(b) => render(&ctx, &b, kernels(&b), &[], true, "rendering B", args.quiet)?,
         Second::Model(model) => {
             a.settings.model = model;
-            render(&ctx, &a, kernels(&a), &[], "rendering B", args.quiet)?
+            render(&ctx, &a, kernels(&a), &[], true, "rendering B", args.quiet)?
         }
     };
     drop(ctx);
