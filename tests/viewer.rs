@@ -673,6 +673,20 @@ fn until_b_finishes_a_pass_its_half_of_the_split_shows_a() {
     assert_matches_render(&region(&shot, right.clone()), &region(&a, right));
 }
 
+/// Each side's relight kernel is compiled once, for its own look's lobes: B's look (chrome and
+/// red plastic) has no clear coat, and its renderer compiled the kernel for every lobe first.
+#[test]
+fn each_side_of_the_split_compiles_its_relight_kernel_once() {
+    let Some(case) = Case::new() else { return };
+    case.write("b.toml", "[[object]]\n[[object.layer]]\npreset = \"red-plastic\"\n\n[[object]]\nid = 1\n[[object.layer]]\npreset = \"chrome\"\n");
+    let args = ["look.toml", "--compare-look", "b.toml", "--exit-after-spp", "1", "--screenshot", "shot.png"];
+    let output = case.view_with_env(&args, &[("LOOKDEV_TIMINGS", "1")]);
+    assert_success(&output);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let compiles = stderr.lines().filter(|l| l.contains("timing: pipeline relight")).count();
+    assert_eq!(compiles, 2, "{stderr}");
+}
+
 #[test]
 fn the_split_view_shows_a_beside_another_look_under_the_same_light() {
     let Some(case) = Case::new() else { return };

@@ -14,6 +14,7 @@ use crate::material::params::Params;
 use crate::material::stack::{layer_weights, LayerWeight, PackedStacks};
 use crate::render::output::{self, OutputFormat};
 use crate::render::renderer::{KernelSource, NoiseThreshold, Specialization};
+use crate::render::sampling::Sampling;
 use crate::render::scene::covered_object_ids;
 use crate::render::{Lighting, Renderer};
 use crate::shading::model::Model;
@@ -152,6 +153,28 @@ pub struct SnapshotCompare {
     delta_key: Option<(u32, u64)>,
 }
 
+/// A renderer of `model` and the estimator `sampling` with `packed` set, its relight kernel made
+/// for their lobes: compiled once, where setting the stacks on a renderer made for every lobe
+/// would compile it again.
+fn stacks_renderer(
+    ctx: &Context,
+    gbuffer: &GBuffer,
+    environment: &Environment,
+    model: Model,
+    sampling: Sampling,
+    packed: &PackedStacks,
+) -> Result<Renderer> {
+    let kernels = KernelSource::Compile(Specialization {
+        model,
+        product: sampling.product_kernel(),
+        lobes: packed.lobes(),
+        ..Specialization::default()
+    });
+    let mut renderer = Renderer::with_kernels(ctx, gbuffer, environment, sampling, kernels)?;
+    renderer.set_stacks(packed)?;
+    Ok(renderer)
+}
+
 impl Session {
     /// `environment` is the one `document`'s settings name, already loaded.
     pub fn new(
@@ -166,16 +189,7 @@ impl Session {
         let masks: Vec<String> = gbuffer.masks.keys().cloned().collect();
         let packed = PackedStacks::pack(document.look(), objects.iter().copied(), &gbuffer, &gbuffer_name)?;
         let settings = document.settings().clone();
-        // Made for the look's estimator and lobes, so that neither set_stacks nor set_sampling
-        // compiles the relight kernel again.
-        let kernels = KernelSource::Compile(Specialization {
-            model: settings.model,
-            product: settings.sampling.product_kernel(),
-            lobes: packed.lobes(),
-            ..Specialization::default()
-        });
-        let mut renderer = Renderer::with_kernels(ctx, &gbuffer, &environment, settings.sampling, kernels)?;
-        renderer.set_stacks(&packed)?;
+        let mut renderer = stacks_renderer(ctx, &gbuffer, &environment, settings.model, settings.sampling, &packed)?;
         renderer.set_lighting(settings.lighting);
         renderer.set_seed(settings.seed);
         renderer.set_noise_threshold(settings.noise)?;
@@ -398,8 +412,9 @@ impl Session {
             .find(|(p, _)| *p == self.shown.environment)
             .map(|(_, e)| e)
             .ok_or_else(|| Error::gpu("the environment on screen is not loaded"))?;
-        let mut renderer = Renderer::with_model(&self.ctx, &self.gbuffer, environment, &subject.model())?;
-        renderer.set_stacks(&packed)?;
+        // B samples as A does.
+        let sampling = self.renderer.sampling();
+        let mut renderer = stacks_renderer(&self.ctx, &self.gbuffer, environment, subject.model(), sampling, &packed)?;
         renderer.set_lighting(self.shown.lighting);
         renderer.set_seed(self.shown.seed);
         renderer.set_noise_threshold(self.shown.noise)?;

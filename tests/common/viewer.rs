@@ -88,9 +88,16 @@ impl Case {
 
     /// Runs the viewer on the case's g-buffer; a run past [`HANG`] is killed and fails.
     pub fn view(&self, args: &[&str]) -> Output {
+        self.view_with_env(args, &[])
+    }
+
+    /// [`Case::view`] with the environment variables `env` set.
+    pub fn view_with_env(&self, args: &[&str], env: &[(&str, &str)]) -> Output {
         let mut all = vec!["view", "--gbuffer", "g.exr", "--window-size", WINDOW[0], WINDOW[1], "--zoom", "1"];
         all.extend_from_slice(args);
-        let mut child = self.command(&all).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+        let mut command = self.command(&all);
+        command.envs(env.iter().copied());
+        let mut child = command.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
         let start = Instant::now();
         while child.try_wait().unwrap().is_none() {
             if start.elapsed() > HANG {
