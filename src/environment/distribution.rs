@@ -101,14 +101,14 @@ impl Table {
         lo
     }
 
-    /// The GPU's bucket entries of this table: entry k is (cdf[g], cdf[g + 1], g, guide[k + 1])
-    /// for g = guide[k]. When a bucket holds one interval (g = guide[k + 1]), as it usually does,
-    /// that one fetch is the whole search.
-    pub fn bucket_texels(&self) -> impl Iterator<Item = [f32; 4]> + '_ {
-        (0..self.len()).map(|k| {
+    /// Writes the GPU's bucket entries of this table at the start of `out`: entry k is
+    /// (cdf[g], cdf[g + 1], g, guide[k + 1]) for g = guide[k]. When a bucket holds one interval
+    /// (g = guide[k + 1]), as it usually does, that one fetch is the whole search.
+    pub fn write_buckets(&self, out: &mut [[f32; 4]]) {
+        for (k, texel) in out[..self.len()].iter_mut().enumerate() {
             let g = self.guide[k] as usize;
-            [self.cdf[g], self.cdf[g + 1], g as f32, self.guide[k + 1] as f32]
-        })
+            *texel = [self.cdf[g], self.cdf[g + 1], g as f32, self.guide[k + 1] as f32];
+        }
     }
 }
 
@@ -289,9 +289,7 @@ impl Distribution {
         let (width, _) = self.table_size();
         for (row, table) in out.chunks_mut(width as usize).zip(self.tables()) {
             row.fill([0.0; 4]);
-            for (texel, entry) in row.iter_mut().zip(table.bucket_texels()) {
-                *texel = entry;
-            }
+            table.write_buckets(row);
         }
     }
 

@@ -324,10 +324,7 @@ impl Product {
         let (width, _, _) = self.table_size();
         out.fill([0.0; 4]);
         for ((x, row), table) in self.placed_tables(d) {
-            let start = (row * width + x) as usize;
-            for (texel, entry) in out[start..].iter_mut().zip(table.bucket_texels()) {
-                *texel = entry;
-            }
+            table.write_buckets(&mut out[(row * width + x) as usize..]);
         }
     }
 

@@ -801,10 +801,10 @@ impl Renderer {
         self.resolve.set_stacks(&self.ctx, &mut self.gbuffer, packed, &self.targets)?;
         let (width, height) = (self.width, self.height);
         self.timed(|renderer, cmd| renderer.resolve.record(cmd, width, height))?;
-        let changed = self.resolve.changed_pixels(width as usize * height as usize)?;
         if respecialised {
             return Ok(None);
         }
+        let changed = self.resolve.changed_pixels(width as usize * height as usize)?;
         self.restart_pixels(&changed);
         Ok(Some(changed.len()))
     }
