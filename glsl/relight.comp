@@ -39,6 +39,7 @@ layout(constant_id = 8) const uint PRODUCT_SAMPLING = 0u;
 #include "sampling.glsl"
 #include "sobol.glsl"
 #include "environment.glsl"
+#include "pixel_list.glsl"
 
 // Layer 0: N.xyz and coverage A; layer 1: V.xyz; layer 2: T.xyz (unit, orthogonal to N).
 layout(set = 0, binding = 0, rgba32f) uniform readonly image2DArray surface;
@@ -190,15 +191,6 @@ vec3 estimate_lobes(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec
         shares[k] *= pass.intensity;
     }
     return result * pass.intensity;
-}
-
-ivec2 unpack_pixel(uint packed) {
-    return ivec2(int(packed & 0xffffu), int(packed >> 16));
-}
-
-// Entry `i` of a list stored row by row in an image `width` texels wide.
-ivec2 list_texel(uint i, int width) {
-    return ivec2(int(i % uint(width)), int(i / uint(width)));
 }
 
 // The environment behind `pixel`, where the surface does not cover it all.

@@ -3,12 +3,17 @@
 // A layer's value at a pixel is its own value times, for each parameter bound to a map, the
 // map's value there. The bottom layer fills, and each layer above blends in with
 // w = clamp(opacity·m, 0, 1), where m is its mask (or 1 − mask when inverted; 1 without a mask).
-// Runs once per edit, not per sample. Each covered pixel whose material comes out different,
-// bit for bit, from what `resolved` held is flagged in `changed`, so that an edit restarts only
-// the pixels it changed (docs/commands.md#edit-local-re-convergence).
+// Runs once per edit, not per sample, over a list of pixels: the covered pixels of the stacks
+// that changed since the last resolve (every other stack resolves as it did before; uncovered
+// pixels are never relit nor read, as the AOVs and the denoiser weigh by coverage, so they keep
+// the image's clear 0). Each pixel whose material comes out different, bit for bit, from what
+// `resolved` held is flagged in `changed`, so that an edit restarts only the pixels it changed
+// (docs/commands.md#edit-local-re-convergence).
 #extension GL_GOOGLE_include_directive : require
 
-layout(local_size_x = 16, local_size_y = 16) in;
+#include "pixel_list.glsl"
+
+layout(local_size_x = 64) in;
 
 // Per pixel: the index of its object's stack.
 layout(set = 0, binding = 0, r32ui) uniform readonly uimage2D stack_index;
@@ -38,14 +43,19 @@ layout(set = 0, binding = 3, std430) readonly buffer Layers {
 };
 
 layout(set = 0, binding = 4, rgba32f) uniform image2DArray resolved;
-// Layer 0: N.xyz and coverage A (relight.comp's `surface`): uncovered pixels are never relit,
-// so a change there restarts nothing.
-layout(set = 0, binding = 5, rgba32f) uniform readonly image2DArray surface;
-// One bit per pixel, index y·width + x, cleared before the dispatch: set where a covered
-// pixel's material changed.
+// The pixels to resolve, as a list (pixel_list.glsl).
+layout(set = 0, binding = 5, r32ui) uniform readonly uimage2D pixels;
+// One bit per pixel, index y·width + x, cleared before the dispatch: set where a pixel's
+// material changed.
 layout(set = 0, binding = 6, std430) buffer Changed {
     uint changed[];
 };
+
+// The list entries this dispatch resolves: first .. end - 1.
+layout(push_constant) uniform Pass {
+    uint first;
+    uint end;
+} pass;
 
 float channel(ivec2 pixel, int layer) {
     return imageLoad(channels, ivec3(pixel, layer)).r;
@@ -65,11 +75,12 @@ void layer_material(uint index, ivec2 pixel, out vec4 p[5]) {
 }
 
 void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-    ivec2 size = imageSize(stack_index);
-    if (pixel.x >= size.x || pixel.y >= size.y) {
+    uint entry = pass.first + gl_GlobalInvocationID.x;
+    if (entry >= pass.end) {
         return;
     }
+    ivec2 size = imageSize(stack_index);
+    ivec2 pixel = unpack_pixel(imageLoad(pixels, list_texel(entry, size.x)).r);
     Stack stack = stacks[imageLoad(stack_index, pixel).r];
     vec4 p[5];
     layer_material(stack.first_layer, pixel, p);
@@ -90,7 +101,7 @@ void main() {
         differs = differs || any(notEqual(before, floatBitsToUint(p[k])));
         imageStore(resolved, ivec3(pixel, k), p[k]);
     }
-    if (differs && imageLoad(surface, ivec3(pixel, 0)).a > 0.0) {
+    if (differs) {
         uint index = uint(pixel.y * size.x + pixel.x);
         atomicOr(changed[index >> 5], 1u << (index & 31u));
     }

@@ -22,6 +22,18 @@ pub struct GpuGBuffer {
     /// The channels the current stacks read, one layer each, with their names: kept while
     /// edits leave the list alone, so that changing a value uploads no channel again.
     channel_layers: Option<(Vec<String>, Image)>,
+    /// The current stacks' index per pixel, kept while edits leave the objects' stacks where
+    /// they are.
+    stack_index: Option<StackIndex>,
+}
+
+/// Each pixel's stack, as resolve.comp reads it, and for which objects' stacks it was made.
+pub struct StackIndex {
+    stack_of_object: BTreeMap<u32, u32>,
+    /// Per pixel (`y * width + x`): its index into the stacks.
+    pub of_pixel: Vec<u32>,
+    /// The same, R32_UINT.
+    pub image: Image,
 }
 
 impl GpuGBuffer {
@@ -45,21 +57,27 @@ impl GpuGBuffer {
             ids: gbuffer.object_id.clone(),
             channels: masks.chain(maps).collect(),
             channel_layers: None,
+            stack_index: None,
         })
     }
 
-    /// Each pixel's index into `packed`'s stacks, as an R32_UINT image.
-    pub fn stack_index(&self, ctx: &Context, packed: &PackedStacks) -> Result<Image> {
-        // Uncovered pixels may carry ids the stacks leave out; they shade nothing, so stack 0 does.
-        let index: Vec<u32> = self.ids.iter().map(|id| packed.stack_of_object.get(id).copied().unwrap_or(0)).collect();
-        let image = Image::new(ctx, vk::Format::R32_UINT, self.width, self.height, 1, false)?;
-        image.upload(ctx, bytemuck::cast_slice(&index))?;
-        Ok(image)
+    /// Each pixel's index into `packed`'s stacks, on the host and as an R32_UINT image; made
+    /// again only when the objects map to other stacks.
+    fn stack_index(&mut self, ctx: &Context, packed: &PackedStacks) -> Result<&StackIndex> {
+        if self.stack_index.as_ref().is_none_or(|s| s.stack_of_object != packed.stack_of_object) {
+            // Uncovered pixels may carry ids the stacks leave out; they shade nothing, so stack 0 does.
+            let of_pixel: Vec<u32> =
+                self.ids.iter().map(|id| packed.stack_of_object.get(id).copied().unwrap_or(0)).collect();
+            let image = Image::new(ctx, vk::Format::R32_UINT, self.width, self.height, 1, false)?;
+            image.upload(ctx, bytemuck::cast_slice(&of_pixel))?;
+            self.stack_index = Some(StackIndex { stack_of_object: packed.stack_of_object.clone(), of_pixel, image });
+        }
+        Ok(self.stack_index.as_ref().expect("just made"))
     }
 
     /// The mask and map channels `packed` reads, one layer each in its order (at least one
     /// layer, so the binding is always valid); uploaded only when the list changes.
-    pub fn channel_layers(&mut self, ctx: &Context, packed: &PackedStacks) -> Result<&Image> {
+    fn channel_layers(&mut self, ctx: &Context, packed: &PackedStacks) -> Result<&Image> {
         if self.channel_layers.as_ref().is_none_or(|(names, _)| *names != packed.channels) {
             let pixels = self.ids.len();
             let layers = packed.channels.len().max(1) as u32;
@@ -75,9 +93,11 @@ impl GpuGBuffer {
         Ok(&self.channel_layers.as_ref().expect("just made").1)
     }
 
-    /// [`Self::channel_layers`] with the surface image beside it, for a pass that binds both.
-    pub fn surface_and_channel_layers(&mut self, ctx: &Context, packed: &PackedStacks) -> Result<(&Image, &Image)> {
+    /// What the resolve of `packed` reads: each pixel's stack ([`Self::stack_index`]) and the
+    /// channels ([`Self::channel_layers`]).
+    pub fn resolve_inputs(&mut self, ctx: &Context, packed: &PackedStacks) -> Result<(&StackIndex, &Image)> {
         self.channel_layers(ctx, packed)?;
-        Ok((&self.surface, &self.channel_layers.as_ref().expect("just made").1))
+        self.stack_index(ctx, packed)?;
+        Ok((self.stack_index.as_ref().expect("just made"), &self.channel_layers.as_ref().expect("just made").1))
     }
 }

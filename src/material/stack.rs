@@ -255,6 +255,26 @@ impl PackedStacks {
         }
     }
 
+    /// Which of these stacks may resolve to another material than `before`'s did, at some
+    /// pixel: every one when there was nothing before, or when pixels map to stacks differently
+    /// or the layers read other channels; otherwise those whose layers differ, bit for bit.
+    /// A stack marked false resolves to exactly what `before`'s did wherever it is used.
+    pub fn changed_since(&self, before: Option<&PackedStacks>) -> Vec<bool> {
+        fn layers_of<'a>(packed: &'a PackedStacks, stack: &GpuStack) -> &'a [u8] {
+            let first = stack.first_layer as usize;
+            bytemuck::cast_slice(&packed.layers[first..first + stack.layer_count as usize])
+        }
+        match before {
+            Some(b) if b.stack_of_object == self.stack_of_object && b.channels == self.channels => self
+                .stacks
+                .iter()
+                .enumerate()
+                .map(|(i, stack)| b.stacks.get(i).is_none_or(|old| layers_of(b, old) != layers_of(self, stack)))
+                .collect(),
+            _ => vec![true; self.stacks.len()],
+        }
+    }
+
     /// The GPU channel layer of a g-buffer channel, added on first use.
     fn channel_index(&mut self, channel: &str) -> i32 {
         let index = self.channels.iter().position(|c| c == channel).unwrap_or_else(|| {
@@ -404,6 +424,42 @@ mod tests {
         for (c, e) in [2.0f32, 4.0, 8.0].into_iter().enumerate() {
             assert!((p.emission[c] - mixed(0.0, e * 0.25)).abs() < 1e-6, "{:?}", p.emission);
         }
+    }
+
+    #[test]
+    fn a_stack_changes_when_its_layers_or_what_they_read_do() {
+        // Objects 1 and 2, each with its own stack.
+        let pack2 = |ball: Vec<Layer>, pedestal: Vec<Layer>| {
+            let mut look = Look::default_material();
+            look.objects = vec![ObjectStack::new(Some(1), ball), ObjectStack::new(Some(2), pedestal)];
+            let mut g = gbuffer();
+            g.object_id = vec![1];
+            PackedStacks::pack(&look, [1, 2], &g, Path::new("test.exr")).unwrap()
+        };
+        let before = pack2(vec![layer(0.5, None, true)], vec![layer(0.2, None, true)]);
+        assert_eq!(before.changed_since(None), [true, true], "nothing resolved yet");
+        assert_eq!(before.changed_since(Some(&before)), [false, false]);
+        let rougher = pack2(vec![layer(0.6, None, true)], vec![layer(0.2, None, true)]);
+        assert_eq!(rougher.changed_since(Some(&before)), [true, false]);
+        // A layer more in the first stack moves the second's layers, not their contents.
+        let two = pack2(vec![layer(0.5, None, true), layer(0.9, None, true)], vec![layer(0.2, None, true)]);
+        assert_eq!(two.changed_since(Some(&before)), [true, false]);
+        // -0 and 0 resolve to different bits: compared as bits, they differ.
+        let negative_zero = pack2(vec![layer(0.5, None, true)], vec![layer(-0.0, None, true)]);
+        let zero = pack2(vec![layer(0.5, None, true)], vec![layer(0.0, None, true)]);
+        assert_eq!(negative_zero.changed_since(Some(&zero)), [false, true]);
+        // Another channel list renumbers every layer's masks and maps: all change.
+        let grunge =
+            pack2(vec![layer(0.5, None, true)], vec![layer(0.2, None, true), layer(0.3, Some("grunge"), true)]);
+        let both = pack2(
+            vec![layer(0.5, None, true), layer(0.9, Some("stripes"), true)],
+            vec![layer(0.2, None, true), layer(0.3, Some("grunge"), true)],
+        );
+        assert_eq!(both.changed_since(Some(&grunge)), [true, true]);
+        // Objects mapped to other stacks: all change.
+        let mut swapped = before.clone();
+        swapped.stack_of_object = [(1, 1), (2, 0)].into();
+        assert_eq!(swapped.changed_since(Some(&before)), [true, true]);
     }
 
     #[test]

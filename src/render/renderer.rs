@@ -356,16 +356,22 @@ impl Renderer {
         }
     }
 
-    /// Uploads new layer stacks and resolves them into one material per pixel (once per edit,
-    /// not per sample). Accumulation restarts, and the relight kernel is respecialised first if
+    /// Uploads new layer stacks and resolves them into one material per covered pixel (once per
+    /// edit, not per sample; only the pixels of the stacks that changed). Accumulation restarts, and the relight kernel is respecialised first if
     /// the stacks have other lobes ([`PackedStacks::lobes`]): a kernel the driver refuses
     /// leaves the renderer as it was.
     pub fn set_stacks(&mut self, packed: &PackedStacks) -> Result<()> {
         self.set_lobes(packed.lobes())?;
-        self.resolve.set_stacks(&self.ctx, &mut self.gbuffer, packed, &self.targets)?;
-        let (width, height) = (self.width, self.height);
-        self.timed(|renderer, cmd| renderer.resolve.record(cmd, width, height))?;
+        self.resolve_stacks(packed)?;
         self.restart();
+        Ok(())
+    }
+
+    /// Uploads `packed` and resolves the pixels of the stacks that changed.
+    fn resolve_stacks(&mut self, packed: &PackedStacks) -> Result<()> {
+        self.resolve.set_stacks(&self.ctx, &mut self.gbuffer, packed, &self.targets, &self.lists.covered)?;
+        self.timed(|renderer, cmd| renderer.resolve.record(cmd))?;
+        self.resolve.mark_resolved(packed);
         Ok(())
     }
 
@@ -798,13 +804,11 @@ impl Renderer {
     /// restarts, as with [`Renderer::set_stacks`], and this returns None.
     pub fn set_stacks_local(&mut self, packed: &PackedStacks) -> Result<Option<usize>> {
         let respecialised = self.set_lobes(packed.lobes())?;
-        self.resolve.set_stacks(&self.ctx, &mut self.gbuffer, packed, &self.targets)?;
-        let (width, height) = (self.width, self.height);
-        self.timed(|renderer, cmd| renderer.resolve.record(cmd, width, height))?;
+        self.resolve_stacks(packed)?;
         if respecialised {
             return Ok(None);
         }
-        let changed = self.resolve.changed_pixels(width as usize * height as usize)?;
+        let changed = self.resolve.changed_pixels(self.width as usize * self.height as usize)?;
         self.restart_pixels(&changed);
         Ok(Some(changed.len()))
     }

@@ -32,6 +32,24 @@ fn groups(width: u32, rows: u32) -> [u32; 3] {
     [group_count(width, LOCAL_SIZE[0]), group_count(rows, LOCAL_SIZE[1]), 1]
 }
 
+/// Invocations per workgroup of the kernels that run over a pixel list (`local_size_x` in
+/// relight.comp and resolve.comp): a multiple of every subgroup size in use (8 on lavapipe, 32
+/// or 64 on GPUs).
+const LIST_LOCAL_SIZE: u32 = 64;
+
+/// Workgroups per dispatch at most: the least `maxComputeWorkGroupCount[0]` Vulkan allows.
+const MAX_GROUPS: u32 = 65_535;
+
+/// The dispatches that run a list kernel over the entries `first..end`: each one's range and
+/// workgroups, at most [`MAX_GROUPS`] of them.
+fn list_dispatches(first: u32, end: u32) -> impl Iterator<Item = (u32, u32, [u32; 3])> {
+    let step = MAX_GROUPS * LIST_LOCAL_SIZE;
+    (first..end).step_by(step as usize).map(move |start| {
+        let stop = end.min(start.saturating_add(step));
+        (start, stop, [(stop - start).div_ceil(LIST_LOCAL_SIZE), 1, 1])
+    })
+}
+
 /// The resolved material's layers: the five vec4s of `Params::to_gpu`.
 pub const RESOLVED_LAYERS: u32 = (crate::material::params::GPU_FLOATS / 4) as u32;
 

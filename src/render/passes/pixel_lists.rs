@@ -79,8 +79,7 @@ impl PixelLists {
 
     /// Writes `list` as the restarted pixels.
     pub fn upload_restarted(&self, ctx: &Context, list: &RowList) -> Result<()> {
-        let (width, height) = (self.restarted_image.width, self.restarted_image.height);
-        self.restarted_image.upload(ctx, &padded(&list.pixels, width, height))
+        upload_list(ctx, &self.restarted_image, &list.pixels)
     }
 
     /// Sets the active counts of rows `first_row..end_row` to zero before a pass counts them.
@@ -96,8 +95,13 @@ impl PixelLists {
 }
 
 /// An image that holds a list of up to `width` × `height` pixels.
-fn list_image(ctx: &Context, width: u32, height: u32) -> Result<Image> {
+pub fn list_image(ctx: &Context, width: u32, height: u32) -> Result<Image> {
     Image::new(ctx, vk::Format::R32_UINT, width, height, 1, false)
+}
+
+/// Writes `pixels` (packed, at most the image's texels) into the list image `image`.
+pub fn upload_list(ctx: &Context, image: &Image, pixels: &[u32]) -> Result<()> {
+    image.upload(ctx, &padded(pixels, image.width, image.height))
 }
 
 /// `pixels` padded with zeros to the bytes of a `width` × `height` list image.

@@ -37,13 +37,6 @@ pub const SET: [BindingKind; 10] = [
     BindingKind::StorageBuffer,
 ];
 
-/// Invocations per workgroup (`local_size_x` in relight.comp): a multiple of every subgroup
-/// size in use (8 on lavapipe, 32 or 64 on GPUs).
-const LOCAL_SIZE: u32 = 64;
-
-/// Workgroups per dispatch at most: the least `maxComputeWorkGroupCount[0]` Vulkan allows.
-const MAX_GROUPS: u32 = 65_535;
-
 /// Which pixels a relight dispatch's invocations stand for (`SOURCE_*` in relight.comp).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u32)]
@@ -196,16 +189,13 @@ impl RelightPass {
         Ok(())
     }
 
-    /// Records the pass over the invocations `push.first..push.end`, in dispatches of at most
-    /// [`MAX_GROUPS`] workgroups. Their pixels are disjoint, so the dispatches need no barrier.
+    /// Records the pass over the invocations `push.first..push.end`, in as many dispatches as
+    /// the workgroup limit needs. Their pixels are disjoint, so the dispatches need no barrier.
     pub fn record(&self, cmd: vk::CommandBuffer, push: &RelightPush) {
         let sets = [&self.set, &self.environment_set];
-        let mut first = push.first;
-        while first < push.end {
-            let end = push.end.min(first.saturating_add(MAX_GROUPS * LOCAL_SIZE));
+        for (first, end, groups) in super::list_dispatches(push.first, push.end) {
             let chunk = RelightPush { first, end, ..*push };
-            self.pipeline.dispatch(cmd, &sets, bytemuck::bytes_of(&chunk), [(end - first).div_ceil(LOCAL_SIZE), 1, 1]);
-            first = end;
+            self.pipeline.dispatch(cmd, &sets, bytemuck::bytes_of(&chunk), groups);
         }
     }
 }

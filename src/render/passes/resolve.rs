@@ -1,9 +1,11 @@
 //! The resolve pass (`resolve.comp`): each pixel's layer stack, blended through its masks and
 //! maps into one material, written to [`Targets::resolved`](super::Targets). It runs once per
-//! edit of the stacks, not per sample, and flags the covered pixels whose material it changed,
-//! bit for bit, so that an edit can restart only those (docs/commands.md#edit-local-re-convergence).
+//! edit of the stacks, not per sample, over the covered pixels of the stacks that changed since
+//! the last resolve, and flags the pixels whose material it changed, bit for bit, so that an
+//! edit can restart only those (docs/commands.md#edit-local-re-convergence).
 
-use super::{groups, Targets};
+use super::pixel_lists::{self, RowList};
+use super::Targets;
 use crate::gbuffer::gpu::GpuGBuffer;
 use crate::gpu::{
     shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, GlslLayout, Image, Interface,
@@ -13,7 +15,7 @@ use crate::Result;
 use ash::vk;
 
 /// Set 0 of `resolve.comp`: stack index per pixel, mask and map channels, stacks, layers, the
-/// resolved material, the surface (for coverage), and the bits of the pixels that changed.
+/// resolved material, the list of pixels to resolve, and the bits of the pixels that changed.
 pub const SET: [BindingKind; 7] = [
     BindingKind::StorageImage,
     BindingKind::StorageImage,
@@ -24,17 +26,30 @@ pub const SET: [BindingKind; 7] = [
     BindingKind::StorageBuffer,
 ];
 
-/// What `resolve.comp` and the host agree on: no push constants, and the stacks and layers as
+/// What `resolve.comp` and the host agree on: the push constants, and the stacks and layers as
 /// [`PackedStacks`] holds them.
-pub const INTERFACE: Interface =
-    Interface { structs: &[GpuStack::GLSL, GpuLayer::GLSL], ..Interface::compute(&shaders::RESOLVE, &[&SET], None) };
+pub const INTERFACE: Interface = Interface {
+    structs: &[GpuStack::GLSL, GpuLayer::GLSL],
+    ..Interface::compute(&shaders::RESOLVE, &[&SET], Some(ResolvePush::GLSL))
+};
+
+/// `resolve.comp`'s push constants: the entries of the pixel list one dispatch resolves.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct ResolvePush {
+    first: u32,
+    end: u32,
+}
+
+crate::glsl_struct!(ResolvePush as "Pass", 8 bytes { first @ 0, end @ 4 });
 
 /// The stacks on the GPU, held while the set points at them.
 struct Stacks {
-    _stack_index: Image,
     _stacks: Buffer,
     _layers: Buffer,
     set: DescriptorSet,
+    /// Entries of the pixel list to resolve.
+    pixels: u32,
 }
 
 /// The resolve pipeline, the stacks it reads, and the change bits it writes.
@@ -42,15 +57,20 @@ pub struct ResolvePass {
     ctx: Context,
     pipeline: ComputePipeline,
     stacks: Option<Stacks>,
+    /// The stacks whose resolve the resolved image holds, once a resolve of them has run: a
+    /// later resolve skips the pixels of every stack unchanged since.
+    resolved: Option<PackedStacks>,
     /// One bit per pixel (index y·width + x, 32 to a word), set by the last resolve where a
     /// covered pixel's material changed; made with the first stacks.
     changed: Option<Buffer>,
+    /// The pixels to resolve, a list image; made with the first stacks.
+    list: Option<Image>,
 }
 
 impl ResolvePass {
     /// The pass, with its pipeline compiled by [`ResolvePass::pipeline`].
     pub fn new(ctx: &Context, pipeline: ComputePipeline) -> ResolvePass {
-        ResolvePass { ctx: ctx.clone(), pipeline, stacks: None, changed: None }
+        ResolvePass { ctx: ctx.clone(), pipeline, stacks: None, resolved: None, changed: None, list: None }
     }
 
     /// Compiles `resolve.comp`.
@@ -58,37 +78,52 @@ impl ResolvePass {
         ComputePipeline::new(ctx, &shaders::RESOLVE, INTERFACE.sets, INTERFACE.push_size())
     }
 
-    /// Uploads `packed` (and the g-buffer channels it reads) and binds it for [`Self::record`].
+    /// Uploads `packed` (and the g-buffer channels it reads) and binds it for [`Self::record`],
+    /// with the list of the `covered` pixels whose stack differs from the one last resolved
+    /// there; until [`Self::mark_resolved`], none counts as resolved.
     pub fn set_stacks(
         &mut self,
         ctx: &Context,
         gbuffer: &mut GpuGBuffer,
         packed: &PackedStacks,
         targets: &Targets,
+        covered: &RowList,
     ) -> Result<()> {
-        let stack_index = gbuffer.stack_index(ctx, packed)?;
+        let (width, height) = (targets.resolved.width, targets.resolved.height);
+        let changed_stacks = packed.changed_since(self.resolved.take().as_ref());
+        let (stack_index, channels) = gbuffer.resolve_inputs(ctx, packed)?;
+        let pixels = pixels_to_resolve(&covered.pixels, width, &stack_index.of_pixel, &changed_stacks);
+        if self.list.is_none() {
+            self.list = Some(pixel_lists::list_image(ctx, width, height)?);
+        }
+        let list = self.list.as_ref().expect("just made");
+        pixel_lists::upload_list(ctx, list, &pixels)?;
         let stacks = Buffer::with_data(ctx, bytemuck::cast_slice(&packed.stacks))?;
         let layers = Buffer::with_data(ctx, bytemuck::cast_slice(&packed.layers))?;
-        let pixels = targets.resolved.width as u64 * targets.resolved.height as u64;
         if self.changed.is_none() {
-            self.changed = Some(Buffer::storage(ctx, pixels.div_ceil(32) * 4)?);
+            self.changed = Some(Buffer::storage(ctx, (width as u64 * height as u64).div_ceil(32) * 4)?);
         }
         let changed = self.changed.as_ref().expect("just made");
-        let (surface, channels) = gbuffer.surface_and_channel_layers(ctx, packed)?;
         let set = self.pipeline.bind(
             0,
             &[
-                Binding::Image(&stack_index),
+                Binding::Image(&stack_index.image),
                 Binding::Image(channels),
                 Binding::Buffer(&stacks),
                 Binding::Buffer(&layers),
                 Binding::Image(&targets.resolved),
-                Binding::Image(surface),
+                Binding::Image(list),
                 Binding::Buffer(changed),
             ],
         )?;
-        self.stacks = Some(Stacks { _stack_index: stack_index, _stacks: stacks, _layers: layers, set });
+        self.stacks = Some(Stacks { _stacks: stacks, _layers: layers, set, pixels: pixels.len() as u32 });
         Ok(())
+    }
+
+    /// Notes that the resolve of the stacks last set has run, so that the next
+    /// [`Self::set_stacks`] flags only the stacks that differ from them.
+    pub fn mark_resolved(&mut self, packed: &PackedStacks) {
+        self.resolved = Some(packed.clone());
     }
 
     /// Whether stacks have been set.
@@ -96,15 +131,16 @@ impl ResolvePass {
         self.stacks.is_some()
     }
 
-    /// Records the resolve of every pixel of a `width` × `height` image, after clearing the
-    /// change bits.
-    pub fn record(&self, cmd: vk::CommandBuffer, width: u32, height: u32) {
+    /// Records the resolve of the listed pixels, after clearing the change bits.
+    pub fn record(&self, cmd: vk::CommandBuffer) {
         let stacks = self.stacks.as_ref().expect("set_stacks() runs before the resolve");
         let changed = self.changed.as_ref().expect("made with the stacks");
         let device = &self.ctx.shared.device;
         unsafe { device.cmd_fill_buffer(cmd, changed.buffer, 0, vk::WHOLE_SIZE, 0) };
         crate::gpu::context::full_barrier(device, cmd);
-        self.pipeline.dispatch(cmd, &[&stacks.set], &[], groups(width, height));
+        for (first, end, groups) in super::list_dispatches(0, stacks.pixels) {
+            self.pipeline.dispatch(cmd, &[&stacks.set], bytemuck::bytes_of(&ResolvePush { first, end }), groups);
+        }
     }
 
     /// The covered pixels whose resolved material the last resolve changed, bit for bit, as
@@ -119,6 +155,16 @@ impl ResolvePass {
             .collect();
         Ok(changed_indices(&words, pixels))
     }
+}
+
+/// The entries of `covered` (packed pixels of a `width`-wide image) whose stack, by
+/// `stack_of_pixel` (indexed `y * width + x`), is marked in `changed_stacks`.
+fn pixels_to_resolve(covered: &[u32], width: u32, stack_of_pixel: &[u32], changed_stacks: &[bool]) -> Vec<u32> {
+    if changed_stacks.iter().all(|&c| c) {
+        return covered.to_vec();
+    }
+    let index = |p: u32| ((p >> 16) * width + (p & 0xffff)) as usize;
+    covered.iter().copied().filter(|&p| changed_stacks[stack_of_pixel[index(p)] as usize]).collect()
 }
 
 /// The indices of the set bits of `words` (bit i of word w is index 32·w + i), below `pixels`,
@@ -140,12 +186,25 @@ fn changed_indices(words: &[u32], pixels: usize) -> Vec<u32> {
 
 #[cfg(test)]
 mod tests {
-    use super::changed_indices;
+    use super::{changed_indices, pixels_to_resolve};
+    use crate::render::passes::pixel_lists::pack;
 
     #[test]
     fn change_bits_become_ascending_indices() {
         assert_eq!(changed_indices(&[], 0), Vec::<u32>::new());
         assert_eq!(changed_indices(&[0b1001, 0, 1 << 31], 96), vec![0, 3, 95]);
         assert_eq!(changed_indices(&[u32::MAX], 5), vec![0, 1, 2, 3, 4], "bits past the image are not pixels");
+    }
+
+    #[test]
+    fn only_the_covered_pixels_of_changed_stacks_are_resolved() {
+        // 3 × 2, stacks per pixel [0 1 1 / 2 0 1]; the covered pixels leave out (1, 0).
+        let stack_of_pixel = [0, 1, 1, 2, 0, 1];
+        let covered = [pack(0, 0), pack(2, 0), pack(0, 1), pack(1, 1), pack(2, 1)];
+        let resolved = |changed: &[bool]| pixels_to_resolve(&covered, 3, &stack_of_pixel, changed);
+        assert_eq!(resolved(&[false, true, false]), vec![pack(2, 0), pack(2, 1)]);
+        assert_eq!(resolved(&[true, false, true]), vec![pack(0, 0), pack(0, 1), pack(1, 1)]);
+        assert_eq!(resolved(&[false; 3]), Vec::<u32>::new());
+        assert_eq!(resolved(&[true; 3]), covered.to_vec());
     }
 }
