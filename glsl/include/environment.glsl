@@ -46,6 +46,10 @@ layout(set = 1, binding = 3, std430) readonly buffer EnvInfo {
 // placeholders when off.
 layout(set = 1, binding = 4, rgba32f) uniform readonly image2D env_product_buckets;
 layout(set = 1, binding = 5, r32f) uniform readonly image2D env_product_cdf;
+// Product sampling's span guides (Product::spans): texel (c0 + k, row) is first | last << 16,
+// the cells of row `row` that the target of bucket k of the span from c0 can fall in. 1×1 when
+// off.
+layout(set = 1, binding = 6, r32ui) uniform readonly uimage2D env_product_spans;
 
 // v = acos(d.y)/π, computed as atan2(|d.xz|, d.y)/π: the same angle for a unit d, but well
 // conditioned near the poles, and accurate where a driver's acos is only approximate.
@@ -216,7 +220,8 @@ float env_rescale(float u, vec2 bounds) {
 
 // Samples `cluster`'s product distribution: a coarse cell by its table (u.x), a row of cells in
 // it by the coarse cell's table (u.y), a cell of that row by the global conditional table within
-// the coarse cell's span (u.x rescaled), and a point in the cell. Mirrors Product::sample.
+// the coarse cell's span (u.x rescaled, from the span's guide), and a point in the cell.
+// Mirrors Product::sample.
 vec3 env_sample_product(uint cluster, vec2 u, out uvec2 at) {
     vec2 bounds;
     uint cells = env_coarse_columns * env_coarse_rows;
@@ -236,10 +241,12 @@ vec3 env_sample_product(uint cluster, vec2 u, out uvec2 at) {
     float a = imageLoad(env_cdf, ivec2(c0, 1u + row)).x;
     float b = imageLoad(env_cdf, ivec2(c1, 1u + row)).x;
     float target = a + ux * (b - a);
-    // A plain binary search within the span: its few steps are the same for every lane, where
-    // the row's guide table may crowd a dim span into one long search.
-    uint lo = c0;
-    uint hi = c1;
+    // The span's own guide names the cells the target can fall in, usually one (the row's guide
+    // table would crowd a dim span into one long search); a binary search among them otherwise.
+    uint n = c1 - c0;
+    uint guide = imageLoad(env_product_spans, ivec2(c0 + min(uint(ux * float(n)), n - 1u), row)).x;
+    uint lo = guide & 0xffffu;
+    uint hi = (guide >> 16) + 1u;
     while (hi - lo > 1u) {
         uint mid = (lo + hi) >> 1;
         if (imageLoad(env_cdf, ivec2(mid, 1u + row)).x <= target) {

@@ -113,7 +113,7 @@ impl Table {
 }
 
 /// The smallest f32 u in [0, 1) with `bucket(u, n) == k`.
-fn smallest_in_bucket(k: u32, n: u32) -> f32 {
+pub(crate) fn smallest_in_bucket(k: u32, n: u32) -> f32 {
     let mut u = k as f32 / n as f32;
     while u > 0.0 && bucket(u.next_down(), n) >= k {
         u = u.next_down();

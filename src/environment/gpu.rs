@@ -13,10 +13,12 @@ pub struct GpuEnvironment {
     pub buckets: Image,
     pub cdf: Image,
     pub info: Buffer,
-    /// The product tables (`env_product_buckets`, `env_product_cdf`), or 1×1 placeholders;
-    /// `buckets` is one too when only the product sampler runs ([`Samplers::Product`]).
+    /// The product tables (`env_product_buckets`, `env_product_cdf`, `env_product_spans`), or
+    /// 1×1 placeholders; `buckets` is one too when only the product sampler runs
+    /// ([`Samplers::Product`]).
     pub product_buckets: Image,
     pub product_cdf: Image,
+    pub product_spans: Image,
 }
 
 /// The environment samplers the kernels bound to an environment run, which decide the tables
@@ -66,7 +68,7 @@ impl GpuEnvironment {
             Samplers::Global => None,
             Samplers::Product(p) | Samplers::Mixture(p) => Some(p),
         };
-        let (product_buckets, product_cdf) = match product {
+        let (product_buckets, product_cdf, product_spans) = match product {
             Some(p) => {
                 let (width, bucket_rows, cdf_rows) = p.table_size();
                 if width > max || cdf_rows > max {
@@ -80,9 +82,12 @@ impl GpuEnvironment {
                 (
                     Image::filled(ctx, rgba, width, bucket_rows, |out| p.write_buckets(distribution, out))?,
                     Image::filled(ctx, r32, width, cdf_rows, |out| p.write_cdfs(distribution, out))?,
+                    Image::filled(ctx, vk::Format::R32_UINT, p.columns, p.rows, |out: &mut [u32]| {
+                        out.copy_from_slice(&p.spans)
+                    })?,
                 )
             }
-            None => (placeholder(ctx, rgba)?, placeholder(ctx, r32)?),
+            None => (placeholder(ctx, rgba)?, placeholder(ctx, r32)?, placeholder(ctx, vk::Format::R32_UINT)?),
         };
         // EnvInfo: the header, then env_product_index (one unused word when off, as a buffer
         // may not be empty).
@@ -96,11 +101,11 @@ impl GpuEnvironment {
             None => info.push(0),
         }
         let info = Buffer::with_data(ctx, bytemuck::cast_slice(&info))?;
-        Ok(GpuEnvironment { texels, buckets, cdf, info, product_buckets, product_cdf })
+        Ok(GpuEnvironment { texels, buckets, cdf, info, product_buckets, product_cdf, product_spans })
     }
 
     /// The bindings of descriptor set 1, in `environment.glsl` order.
-    pub fn bindings(&self) -> [Binding<'_>; 6] {
+    pub fn bindings(&self) -> [Binding<'_>; 7] {
         [
             Binding::Image(&self.texels),
             Binding::Image(&self.buckets),
@@ -108,6 +113,7 @@ impl GpuEnvironment {
             Binding::Buffer(&self.info),
             Binding::Image(&self.product_buckets),
             Binding::Image(&self.product_cdf),
+            Binding::Image(&self.product_spans),
         ]
     }
 }
@@ -118,11 +124,12 @@ fn placeholder(ctx: &Context, format: vk::Format) -> Result<Image> {
 }
 
 /// The layout of descriptor set 1.
-pub const SET_LAYOUT: [BindingKind; 6] = [
+pub const SET_LAYOUT: [BindingKind; 7] = [
     BindingKind::StorageImage,
     BindingKind::StorageImage,
     BindingKind::StorageImage,
     BindingKind::StorageBuffer,
+    BindingKind::StorageImage,
     BindingKind::StorageImage,
     BindingKind::StorageImage,
 ];

@@ -17,8 +17,11 @@
 //!   conditional table searched within the coarse cell's span. So the density of the cluster's
 //!   sampler is the global one times ratio(c) = P(c)/G(c), P(c) the cluster table's probability:
 //!   one more fetch turns the stored pdf into the product pdf, for any direction.
+//! - **Span guides.** The cell within the span is found as a global table's is, by a guide
+//!   table: the rescaled u's bucket among the span's cells names the few cells its target can
+//!   fall in ([`span_guides`]), so one fetch replaces a binary search of dependent fetches.
 
-use super::distribution::{Distribution, Table, MAX_CELLS};
+use super::distribution::{bucket, smallest_in_bucket, Distribution, Table, MAX_CELLS};
 use super::sampling::texel_of;
 use crate::shading::common::ONE_MINUS_EPSILON;
 use glam::{UVec2, Vec2, Vec3};
@@ -57,6 +60,58 @@ pub struct Product {
     /// The rows of the table images the coarse cells' tables take, packed several to a row
     /// after the clusters' tables (most have a few entries; a row is as wide as a cluster's).
     pub cell_rows: u32,
+    /// The span guides ([`span_guides`]): `columns` × `rows` entries, as `env_product_spans`
+    /// holds them.
+    pub spans: Vec<u32>,
+}
+
+/// For each row of global cells and each coarse column's span `c0 .. c1` of it, the guide of the
+/// search within the span: entry `c0 + k` of the row is `first | last << 16`, the cells (absolute
+/// columns) that hold the target `a + ux·(b − a)` (a, b the CDF at c0 and c1) of every ux in
+/// bucket k of the span's n = c1 − c0 ([`bucket`]), whether or not the device fuses the multiply
+/// and add. Usually first = last, and that is the whole search.
+fn span_guides(d: &Distribution, coarse_columns: u32) -> Vec<u32> {
+    let columns = d.columns;
+    let mut guides = vec![0u32; (columns * d.rows) as usize];
+    // The least and the greatest ux of each bucket, per span width (there are at most two).
+    let mut limits: Vec<(u32, Vec<(f32, f32)>)> = Vec::new();
+    for cc in 0..coarse_columns {
+        let n = coarse_start(cc + 1, coarse_columns, columns) - coarse_start(cc, coarse_columns, columns);
+        if n > 0 && !limits.iter().any(|(w, _)| *w == n) {
+            let least: Vec<f32> = (0..n).map(|k| smallest_in_bucket(k, n)).collect();
+            let greatest =
+                (0..n).map(|k| if k + 1 < n { least[k as usize + 1].next_down() } else { ONE_MINUS_EPSILON });
+            limits.push((n, least.iter().copied().zip(greatest).collect()));
+        }
+    }
+    for (row, table) in d.conditional.iter().enumerate() {
+        let cdf = &table.cdf;
+        let out = &mut guides[row * columns as usize..(row + 1) * columns as usize];
+        for cc in 0..coarse_columns {
+            let (c0, c1) = (coarse_start(cc, coarse_columns, columns), coarse_start(cc + 1, coarse_columns, columns));
+            let Some((_, buckets)) = limits.iter().find(|(w, _)| *w == c1 - c0) else { continue };
+            let (a, b) = (cdf[c0 as usize], cdf[c1 as usize]);
+            let targets = |ux: f32| {
+                let (plain, fused) = (a + ux * (b - a), ux.mul_add(b - a, a));
+                (plain.min(fused), plain.max(fused))
+            };
+            // The last cell r of the span with cdf[r] <= t, walking up from `from` (t only grows).
+            let last_at_most = |from: u32, t: f32| {
+                let mut r = from;
+                while r + 1 < c1 && cdf[r as usize + 1] <= t {
+                    r += 1;
+                }
+                r
+            };
+            let mut first = c0;
+            for (k, &(least, greatest)) in buckets.iter().enumerate() {
+                first = last_at_most(first, targets(least).0);
+                let last = last_at_most(first, targets(greatest).1);
+                out[c0 as usize + k] = first | last << 16;
+            }
+        }
+    }
+    guides
 }
 
 /// The width of the product tables' images: the longest table's CDF (its entries and 1).
@@ -255,7 +310,8 @@ impl Product {
         let width = table_width(&clusters, &cells);
         let (origins, cell_rows) = pack_tables(&cells, width, clusters.len() as u32);
         let index = Product::build_index(d, coarse_columns, coarse_rows, &origins);
-        Product { grid, coarse_columns, coarse_rows, columns, rows, clusters, cells, ratio, index, cell_rows }
+        let spans = span_guides(d, coarse_columns);
+        Product { grid, coarse_columns, coarse_rows, columns, rows, clusters, cells, ratio, index, cell_rows, spans }
     }
 
     /// [`Product::index`] for the global tables `d` grouped into coarse cells whose tables
@@ -391,8 +447,9 @@ impl Product {
 
     /// Samples a direction for `cluster`, as `env_sample_product` does: a coarse cell by the
     /// cluster's table (u.x), a row of cells within it by its own table (u.y), a cell of that row
-    /// by the global conditional table within the coarse cell's span (u.x rescaled), then a point
-    /// uniform in solid angle within the cell. Returns the direction and its texel.
+    /// by the global conditional table within the coarse cell's span (u.x rescaled, its search
+    /// started from the span's guide), then a point uniform in solid angle within the cell.
+    /// Returns the direction and its texel.
     pub fn sample(&self, d: &Distribution, cluster: u32, u: Vec2) -> (Vec3, UVec2) {
         let table = &self.clusters[cluster as usize];
         let c = table.search(u.x);
@@ -405,8 +462,9 @@ impl Product {
         let conditional = &d.conditional[row as usize];
         let (a, b) = (conditional.cdf[c0 as usize], conditional.cdf[c1 as usize]);
         let target = a + ux * (b - a);
-        // The last cell of the span whose CDF value is ≤ target, by a plain binary search.
-        let (mut lo, mut hi) = (c0 as usize, c1 as usize);
+        // The last cell of the span whose CDF value is ≤ target, among those its guide names.
+        let guide = self.spans[(row * self.columns + c0 + bucket(ux, c1 - c0)) as usize];
+        let (mut lo, mut hi) = ((guide & 0xffff) as usize, (guide >> 16) as usize + 1);
         while hi - lo > 1 {
             let mid = (lo + hi) / 2;
             if conditional.cdf[mid] <= target {
@@ -458,6 +516,57 @@ mod tests {
                 (env, d, p)
             })
             .collect()
+    }
+
+    /// Each span guide names cells that hold the answer of a plain binary search within the
+    /// span, for every ux of its bucket, with the target rounded after the multiply or fused:
+    /// checked at each bucket's least and greatest ux and at random ones, over every row and
+    /// span of each layout case; and the search steps left after the guides are at most half
+    /// of a plain search's.
+    #[test]
+    fn span_guides_hold_the_search_within_the_span() {
+        let mut rng = 0x2545_f491u32;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 17;
+            rng ^= rng << 5;
+            (rng >> 8) as f32 / 16_777_216.0
+        };
+        for (env, d, p) in layout_cases() {
+            let (mut steps, mut plain) = (0, 0);
+            for (row, table) in d.conditional.iter().enumerate() {
+                for cc in 0..p.coarse_columns {
+                    let (c0, c1) = (
+                        coarse_start(cc, p.coarse_columns, d.columns),
+                        coarse_start(cc + 1, p.coarse_columns, d.columns),
+                    );
+                    let n = c1 - c0;
+                    let (a, b) = (table.cdf[c0 as usize], table.cdf[c1 as usize]);
+                    let searched = |target: f32| (c0..c1).rfind(|&r| table.cdf[r as usize] <= target).unwrap();
+                    for k in 0..n {
+                        let guide = p.spans[(row as u32 * d.columns + c0 + k) as usize];
+                        let (first, last) = (guide & 0xffff, guide >> 16);
+                        steps += (last - first + 1).next_power_of_two().trailing_zeros() as usize;
+                        plain += n.next_power_of_two().trailing_zeros() as usize;
+                        let least = smallest_in_bucket(k, n);
+                        let greatest =
+                            if k + 1 < n { smallest_in_bucket(k + 1, n).next_down() } else { ONE_MINUS_EPSILON };
+                        let random = (0..4).map(|_| least + next() * (greatest - least));
+                        for ux in [least, greatest].into_iter().chain(random).filter(|&ux| bucket(ux, n) == k) {
+                            for target in [a + ux * (b - a), ux.mul_add(b - a, a)] {
+                                let r = searched(target);
+                                assert!(
+                                    (first..=last).contains(&r),
+                                    "{}: row {row}, span {c0}..{c1}, ux {ux}: cell {r} outside {first}..={last}",
+                                    env.source
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+            assert!(steps * 2 <= plain, "{}: {steps} search steps after the guides, {plain} without", env.source);
+        }
     }
 
     /// The table images hold every table whole, each where the index says, none overlapping
