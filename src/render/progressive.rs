@@ -9,16 +9,18 @@ use std::time::{Duration, Instant};
 /// progress bar and well below any driver watchdog.
 const TARGET_DISPATCH: Duration = Duration::from_millis(500);
 
-/// The slowest speed assumed of a device, in samples a second, to size the first dispatch:
-/// about a quarter of lavapipe's on two cores. The first dispatch of a small image then holds
-/// several samples, so that a short render takes two dispatches rather than four, each of
-/// which pays the per-pixel set-up again.
+/// The slowest speed assumed of a device, in samples a second, to size the first dispatch
+/// before the renderer has timed one: about a quarter of lavapipe's on two cores. The first
+/// dispatch of a small image then holds several samples, so that a short render takes two
+/// dispatches rather than four, each of which pays the per-pixel set-up again.
 const MIN_SPEED: f64 = 5e6;
 
-/// Samples per pixel of the first dispatch over `pixels` pixels: what [`MIN_SPEED`] does in
-/// an eighth of [`TARGET_DISPATCH`], at least 1 and at most `spp`.
-fn first_batch(pixels: usize, spp: u32) -> u32 {
-    let samples = MIN_SPEED * (TARGET_DISPATCH / 8).as_secs_f64() / pixels.max(1) as f64;
+/// Samples per pixel of the first dispatch over `pixels` pixels: what a device does in an
+/// eighth of [`TARGET_DISPATCH`] at `pace` samples a second (the renderer's last timed
+/// dispatch, set-up included, which understates its speed), or at [`MIN_SPEED`] before one;
+/// at least 1 and at most `spp`.
+fn first_batch(pixels: usize, spp: u32, pace: Option<f64>) -> u32 {
+    let samples = pace.unwrap_or(MIN_SPEED) * (TARGET_DISPATCH / 8).as_secs_f64() / pixels.max(1) as f64;
     (samples as u32).clamp(1, spp.max(1))
 }
 
@@ -40,16 +42,20 @@ pub struct RenderStats {
 pub fn accumulate(renderer: &mut Renderer, spp: u32, mut progress: impl FnMut(u32)) -> Result<RenderStats> {
     let start = Instant::now();
     let mut stats = RenderStats::default();
-    let mut batch = first_batch(renderer.covered_pixels(), spp);
+    let mut batch = first_batch(renderer.pixels_to_relight(), spp, renderer.pace());
     if let Some(noise) = renderer.noise_threshold() {
         // No pixel stops before its minimum: a render whose pixels all stop there ends there.
         batch = batch.min(noise.min_samples.max(1));
     }
     while renderer.samples() < spp && renderer.active_pixels() != Some(0) {
         let count = batch.min(spp - renderer.samples());
+        let pixels = renderer.pixels_to_relight();
         let dispatch_start = Instant::now();
         let gpu = renderer.render_samples(count)?;
         let elapsed = dispatch_start.elapsed();
+        if elapsed >= Duration::from_millis(1) {
+            renderer.set_pace(pixels as f64 * count as f64 / elapsed.as_secs_f64());
+        }
         stats.dispatches += 1;
         stats.gpu_seconds = match (stats.gpu_seconds, gpu) {
             (Some(total), Some(t)) => Some(total + t),
@@ -85,15 +91,20 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_first_dispatch_holds_what_a_slow_device_does_in_an_eighth_of_the_target() {
+    fn the_first_dispatch_holds_what_the_device_does_in_an_eighth_of_the_target() {
         // The 256² sphere's 42208 covered pixels: 7 samples, 0.3 M in all.
-        assert_eq!(first_batch(42_208, 64), 7);
+        assert_eq!(first_batch(42_208, 64, None), 7);
         // A 1080p frame mostly covered, or more pixels than a slow device does in that time: 1.
-        assert_eq!(first_batch(1_500_000, 64), 1);
-        assert_eq!(first_batch(400_000, 64), 1);
+        assert_eq!(first_batch(1_500_000, 64, None), 1);
+        assert_eq!(first_batch(400_000, 64, None), 1);
         // Never more than the render asks for, nor less than one.
-        assert_eq!(first_batch(100, 16), 16);
-        assert_eq!(first_batch(0, 4), 4);
-        assert_eq!(first_batch(100, 0), 1);
+        assert_eq!(first_batch(100, 16, None), 16);
+        assert_eq!(first_batch(0, 4, None), 4);
+        assert_eq!(first_batch(100, 0, None), 1);
+        // Once the renderer has timed a dispatch, its pace: the ball's 296,856 pixels at
+        // 16 M samples a second take 3 samples in 62.5 ms; a slower pace than the assumed
+        // least, fewer.
+        assert_eq!(first_batch(296_856, 16, Some(16e6)), 3);
+        assert_eq!(first_batch(42_208, 64, Some(1e6)), 1);
     }
 }

@@ -84,6 +84,9 @@ pub struct Renderer {
     sampling: Sampling,
     /// The lobes the relight kernel is specialised for: those of the stacks last set.
     lobes: LobesPresent,
+    /// Pixel samples a second of its last dispatch that [`super::progressive::accumulate`]
+    /// timed, set-up included: what sizes the next accumulation's first dispatch.
+    pace: Option<f64>,
 }
 
 impl Renderer {
@@ -153,6 +156,7 @@ impl Renderer {
             denoise: None,
             sampling,
             lobes,
+            pace: None,
         };
         // Kernels compiled for another estimator's sampler are replaced, not used.
         if product != sampling.product_kernel() {
@@ -347,6 +351,27 @@ impl Renderer {
     /// The covered pixels: every pixel the relight pass samples.
     pub fn covered_pixels(&self) -> usize {
         self.lists.covered.pixels.len()
+    }
+
+    /// The pixels the next pass relights: the restarted ones while they catch up, else those
+    /// still active under a noise threshold, else every covered pixel.
+    pub fn pixels_to_relight(&self) -> usize {
+        match (&self.restarted, self.active_pixels()) {
+            (Some(r), _) => r.list.pixels.len(),
+            (None, Some(active)) => active as usize,
+            (None, None) => self.covered_pixels(),
+        }
+    }
+
+    /// Pixel samples a second that a timed dispatch of this renderer reached, set-up included
+    /// ([`Renderer::set_pace`]); None before one.
+    pub fn pace(&self) -> Option<f64> {
+        self.pace
+    }
+
+    /// Notes the pace a dispatch reached, for the next accumulation's first dispatch.
+    pub fn set_pace(&mut self, samples_per_second: f64) {
+        self.pace = Some(samples_per_second);
     }
 
     pub fn set_seed(&mut self, seed: u32) {
