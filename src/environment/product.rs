@@ -69,7 +69,7 @@ pub struct Product {
 /// search within the span: entry `c0 + k` of the row is `first | last << 16`, the cells (absolute
 /// columns) that hold the target `a + ux·(b − a)` (a, b the CDF at c0 and c1) of every ux in
 /// bucket k of the span's n = c1 − c0 ([`bucket`]), whether or not the device fuses the multiply
-/// and add. Usually first = last, and that is the whole search.
+/// and add. Usually one or two cells: no search, or one step.
 fn span_guides(d: &Distribution, coarse_columns: u32) -> Vec<u32> {
     let columns = d.columns;
     let mut guides = vec![0u32; (columns * d.rows) as usize];

@@ -420,7 +420,7 @@ impl Image {
 
     /// Fills every layer with the texels `fill` writes into the staging memory, laid out as
     /// for [`Image::upload`].
-    fn upload_with(&self, ctx: &Context, fill: impl FnOnce(&mut [u8])) -> Result<()> {
+    pub fn upload_with(&self, ctx: &Context, fill: impl FnOnce(&mut [u8])) -> Result<()> {
         let mut staging = Buffer::staging(ctx, self.byte_size())?;
         fill(&mut staging.bytes_mut()[..self.byte_size() as usize]);
         self.copy_from(ctx, &staging, &[self.copy_region()])

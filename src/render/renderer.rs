@@ -382,9 +382,9 @@ impl Renderer {
     }
 
     /// Uploads new layer stacks and resolves them into one material per covered pixel (once per
-    /// edit, not per sample; only the pixels of the stacks that changed). Accumulation restarts, and the relight kernel is respecialised first if
-    /// the stacks have other lobes ([`PackedStacks::lobes`]): a kernel the driver refuses
-    /// leaves the renderer as it was.
+    /// edit, not per sample; only the pixels of the stacks that changed). Accumulation restarts,
+    /// and the relight kernel is respecialised first if the stacks have other lobes
+    /// ([`PackedStacks::lobes`]): a kernel the driver refuses leaves the renderer as it was.
     pub fn set_stacks(&mut self, packed: &PackedStacks) -> Result<()> {
         self.set_lobes(packed.lobes())?;
         self.resolve_stacks(packed)?;
@@ -394,7 +394,7 @@ impl Renderer {
 
     /// Uploads `packed` and resolves the pixels of the stacks that changed.
     fn resolve_stacks(&mut self, packed: &PackedStacks) -> Result<()> {
-        self.resolve.set_stacks(&self.ctx, &mut self.gbuffer, packed, &self.targets, &self.lists.covered)?;
+        self.resolve.set_stacks(&self.ctx, &mut self.gbuffer, packed, &self.targets, &self.lists)?;
         self.timed(|renderer, cmd| renderer.resolve.record(cmd))?;
         self.resolve.mark_resolved(packed);
         Ok(())

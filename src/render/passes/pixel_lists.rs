@@ -71,7 +71,7 @@ impl PixelLists {
         let indices = covered_mask.iter().enumerate().filter(|(_, &c)| c).map(|(i, _)| i as u32);
         let covered = RowList::from_indices(width, height, indices);
         let covered_image = list_image(ctx, width, height)?;
-        covered_image.upload(ctx, &padded(&covered.pixels, width, height))?;
+        upload_list(ctx, &covered_image, &covered.pixels)?;
         let restarted_image = list_image(ctx, width, height)?;
         let active = Buffer::staging(ctx, height as u64 * 4)?;
         Ok(PixelLists { covered, covered_mask, covered_image, restarted_image, active })
@@ -99,16 +99,14 @@ pub fn list_image(ctx: &Context, width: u32, height: u32) -> Result<Image> {
     Image::new(ctx, vk::Format::R32_UINT, width, height, 1, false)
 }
 
-/// Writes `pixels` (packed, at most the image's texels) into the list image `image`.
+/// Writes `pixels` (packed, at most the image's texels) into the list image `image`, straight
+/// into the memory its upload copies from, zeros after them.
 pub fn upload_list(ctx: &Context, image: &Image, pixels: &[u32]) -> Result<()> {
-    image.upload(ctx, &padded(pixels, image.width, image.height))
-}
-
-/// `pixels` padded with zeros to the bytes of a `width` × `height` list image.
-fn padded(pixels: &[u32], width: u32, height: u32) -> Vec<u8> {
-    let mut data = vec![0u32; width as usize * height as usize];
-    data[..pixels.len()].copy_from_slice(pixels);
-    bytemuck::cast_slice(&data).to_vec()
+    image.upload_with(ctx, |bytes| {
+        let (list, rest) = bytes.split_at_mut(std::mem::size_of_val(pixels));
+        list.copy_from_slice(bytemuck::cast_slice(pixels));
+        rest.fill(0);
+    })
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 //! the last resolve, and flags the pixels whose material it changed, bit for bit, so that an
 //! edit can restart only those (docs/commands.md#edit-local-re-convergence).
 
-use super::pixel_lists::{self, RowList};
+use super::pixel_lists::{self, PixelLists};
 use super::Targets;
 use crate::gbuffer::gpu::GpuGBuffer;
 use crate::gpu::{
@@ -79,25 +79,32 @@ impl ResolvePass {
     }
 
     /// Uploads `packed` (and the g-buffer channels it reads) and binds it for [`Self::record`],
-    /// with the list of the `covered` pixels whose stack differs from the one last resolved
-    /// there; until [`Self::mark_resolved`], none counts as resolved.
+    /// with the list of the covered pixels (of `lists`) whose stack differs from the one last
+    /// resolved there: the covered list itself when every stack does. Until
+    /// [`Self::mark_resolved`], none counts as resolved.
     pub fn set_stacks(
         &mut self,
         ctx: &Context,
         gbuffer: &mut GpuGBuffer,
         packed: &PackedStacks,
         targets: &Targets,
-        covered: &RowList,
+        lists: &PixelLists,
     ) -> Result<()> {
         let (width, height) = (targets.resolved.width, targets.resolved.height);
         let changed_stacks = packed.changed_since(self.resolved.take().as_ref());
         let (stack_index, channels) = gbuffer.resolve_inputs(ctx, packed)?;
-        let pixels = pixels_to_resolve(&covered.pixels, width, &stack_index.of_pixel, &changed_stacks);
-        if self.list.is_none() {
-            self.list = Some(pixel_lists::list_image(ctx, width, height)?);
-        }
-        let list = self.list.as_ref().expect("just made");
-        pixel_lists::upload_list(ctx, list, &pixels)?;
+        let (list, pixels) =
+            match pixels_to_resolve(&lists.covered.pixels, width, &stack_index.of_pixel, &changed_stacks) {
+                None => (&lists.covered_image, lists.covered.pixels.len()),
+                Some(pixels) => {
+                    if self.list.is_none() {
+                        self.list = Some(pixel_lists::list_image(ctx, width, height)?);
+                    }
+                    let list = self.list.as_ref().expect("just made");
+                    pixel_lists::upload_list(ctx, list, &pixels)?;
+                    (list, pixels.len())
+                }
+            };
         let stacks = Buffer::with_data(ctx, bytemuck::cast_slice(&packed.stacks))?;
         let layers = Buffer::with_data(ctx, bytemuck::cast_slice(&packed.layers))?;
         if self.changed.is_none() {
@@ -116,7 +123,7 @@ impl ResolvePass {
                 Binding::Buffer(changed),
             ],
         )?;
-        self.stacks = Some(Stacks { _stacks: stacks, _layers: layers, set, pixels: pixels.len() as u32 });
+        self.stacks = Some(Stacks { _stacks: stacks, _layers: layers, set, pixels: pixels as u32 });
         Ok(())
     }
 
@@ -158,13 +165,14 @@ impl ResolvePass {
 }
 
 /// The entries of `covered` (packed pixels of a `width`-wide image) whose stack, by
-/// `stack_of_pixel` (indexed `y * width + x`), is marked in `changed_stacks`.
-fn pixels_to_resolve(covered: &[u32], width: u32, stack_of_pixel: &[u32], changed_stacks: &[bool]) -> Vec<u32> {
+/// `stack_of_pixel` (indexed `y * width + x`), is marked in `changed_stacks`; None when every
+/// stack is, and so every entry.
+fn pixels_to_resolve(covered: &[u32], width: u32, stack_of_pixel: &[u32], changed_stacks: &[bool]) -> Option<Vec<u32>> {
     if changed_stacks.iter().all(|&c| c) {
-        return covered.to_vec();
+        return None;
     }
     let index = |p: u32| ((p >> 16) * width + (p & 0xffff)) as usize;
-    covered.iter().copied().filter(|&p| changed_stacks[stack_of_pixel[index(p)] as usize]).collect()
+    Some(covered.iter().copied().filter(|&p| changed_stacks[stack_of_pixel[index(p)] as usize]).collect())
 }
 
 /// The indices of the set bits of `words` (bit i of word w is index 32·w + i), below `pixels`,
@@ -202,9 +210,9 @@ mod tests {
         let stack_of_pixel = [0, 1, 1, 2, 0, 1];
         let covered = [pack(0, 0), pack(2, 0), pack(0, 1), pack(1, 1), pack(2, 1)];
         let resolved = |changed: &[bool]| pixels_to_resolve(&covered, 3, &stack_of_pixel, changed);
-        assert_eq!(resolved(&[false, true, false]), vec![pack(2, 0), pack(2, 1)]);
-        assert_eq!(resolved(&[true, false, true]), vec![pack(0, 0), pack(0, 1), pack(1, 1)]);
-        assert_eq!(resolved(&[false; 3]), Vec::<u32>::new());
-        assert_eq!(resolved(&[true; 3]), covered.to_vec());
+        assert_eq!(resolved(&[false, true, false]), Some(vec![pack(2, 0), pack(2, 1)]));
+        assert_eq!(resolved(&[true, false, true]), Some(vec![pack(0, 0), pack(0, 1), pack(1, 1)]));
+        assert_eq!(resolved(&[false; 3]), Some(Vec::new()));
+        assert_eq!(resolved(&[true; 3]), None, "every covered pixel: the covered list itself");
     }
 }
