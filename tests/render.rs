@@ -358,6 +358,29 @@ fn renders_are_deterministic() {
     common::gpu::finish(ctx);
 }
 
+/// An accumulation's first dispatch is sized by the pace the renderer last measured: at a pace
+/// that does every sample in the first eighth of a dispatch's target, one dispatch; at a crawl,
+/// one sample first. Either way the image is the same, and the accumulation measures a pace.
+#[test]
+fn the_first_dispatch_follows_the_measured_pace() {
+    let ctx = common::gpu::context();
+    let (gbuffer, look, _) = shaderball_scene(64);
+    let env = Environment::studio();
+    let accumulate = |pace: f64| {
+        let mut r = renderer(&ctx, &gbuffer, &env, &look, Lighting::default());
+        r.set_pace(pace);
+        let stats = lookdev::render::progressive::accumulate(&mut r, 8, |_| {}).unwrap();
+        (stats.dispatches, r.read_radiance().unwrap(), r.pace())
+    };
+    let (fast, fast_image, _) = accumulate(1e15);
+    let (slow, slow_image, measured) = accumulate(1.0);
+    assert_eq!(fast, 1, "every sample in one dispatch");
+    assert!(slow >= 2, "one sample first, then the rest: {slow} dispatches");
+    assert!(fast_image == slow_image, "the split changes no bits");
+    assert!(measured.is_some_and(|p| p > 1.0), "the accumulation measured its pace: {measured:?}");
+    common::gpu::finish(ctx);
+}
+
 /// Every image the passes write, and every display image, starts cleared: what an earlier image
 /// left in the same memory is never read back, or shown by the viewer before its first pass.
 #[test]

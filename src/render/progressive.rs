@@ -53,7 +53,7 @@ pub fn accumulate(renderer: &mut Renderer, spp: u32, mut progress: impl FnMut(u3
         let dispatch_start = Instant::now();
         let gpu = renderer.render_samples(count)?;
         let elapsed = dispatch_start.elapsed();
-        if elapsed >= Duration::from_millis(1) {
+        if !elapsed.is_zero() {
             renderer.set_pace(pixels as f64 * count as f64 / elapsed.as_secs_f64());
         }
         stats.dispatches += 1;
