@@ -15,6 +15,11 @@
 
 layout(local_size_x = 64) in;
 
+// Whether some layer binds a map (PackedStacks::binds_maps). Without, the map code is left out:
+// a SIMD driver runs its twenty tests per layer and pixel even when none is taken, and keeps
+// the material's values in memory around them.
+layout(constant_id = 0) const uint MAPS = 1u;
+
 // Per pixel: the index of its object's stack.
 layout(set = 0, binding = 0, r32ui) uniform readonly uimage2D stack_index;
 // The g-buffer channels the look uses, masks and map channels alike, one layer each.
@@ -65,10 +70,12 @@ float channel(ivec2 pixel, int layer) {
 void layer_material(uint index, ivec2 pixel, out vec4 p[5]) {
     for (int k = 0; k < 5; k++) {
         p[k] = layers[index].params[k];
-        ivec4 maps = layers[index].maps[k];
-        for (int c = 0; c < 4; c++) {
-            if (maps[c] >= 0) {
-                p[k][c] *= channel(pixel, maps[c]);
+        if (MAPS != 0u) {
+            ivec4 maps = layers[index].maps[k];
+            for (int c = 0; c < 4; c++) {
+                if (maps[c] >= 0) {
+                    p[k][c] *= channel(pixel, maps[c]);
+                }
             }
         }
     }

@@ -231,3 +231,47 @@ fn an_edit_that_gives_the_scene_a_lobe_restarts_everything() {
     drop((r, fresh));
     common::gpu::finish(ctx);
 }
+
+/// The resolve kernel leaves its map code out while no layer binds a map. A renderer whose
+/// stacks come to bind one (the bottom layer's roughness times a ramp) resolves it as the CPU
+/// blend does, and as a fresh renderer does, bit for bit; unbinding it gives back the first
+/// material.
+#[test]
+fn binding_a_map_resolves_it_on_a_renderer_made_without_maps() {
+    let ctx = common::gpu::context();
+    let env = Environment::default_builtin();
+    let mut gbuffer = orthographic_sphere(48);
+    let width = gbuffer.width as usize;
+    let ramp = (0..gbuffer.pixel_count()).map(|i| (i % width) as f32 / width as f32).collect();
+    gbuffer.maps.insert("rough".into(), ramp);
+    let mapped_text = SPHERE.replacen(
+        "[[object.layer]]\npreset = \"gold\"",
+        "[object.layer.map]\nroughness = \"rough\"\n[[object.layer]]\npreset = \"gold\"",
+        1,
+    );
+    let (plain, mapped) = (pack(&look(SPHERE), &gbuffer), pack(&look(&mapped_text), &gbuffer));
+    assert!(!plain.binds_maps() && mapped.binds_maps());
+    let resolved = |r: &Renderer| r.read_resolved().unwrap();
+
+    let mut r = renderer(&ctx, &gbuffer, &env, &plain);
+    let first = bits(&resolved(&r));
+    r.set_stacks(&mapped).unwrap();
+    let with_map = resolved(&r);
+    assert!(bits(&with_map) != first, "the map changes the material");
+    assert!(bits(&with_map) == bits(&resolved(&renderer(&ctx, &gbuffer, &env, &mapped))), "as a fresh renderer");
+    let pixels = gbuffer.pixel_count();
+    for i in (0..pixels).filter(|&i| gbuffer.coverage[i] > 0.0) {
+        let cpu = mapped.resolve_gbuffer_pixel(&gbuffer, i).to_gpu();
+        for (k, &want) in cpu.iter().enumerate() {
+            let got = with_map[(k / 4) * pixels + i][k % 4];
+            assert!(
+                (got - want).abs() <= 1e-6 * want.abs().max(1.0),
+                "pixel {i}, value {k}: {got} against the CPU's {want}"
+            );
+        }
+    }
+    r.set_stacks(&plain).unwrap();
+    assert!(bits(&resolved(&r)) == first, "unbound, the first material");
+    drop(r);
+    common::gpu::finish(ctx);
+}

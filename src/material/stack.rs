@@ -255,6 +255,11 @@ impl PackedStacks {
         }
     }
 
+    /// Whether some layer binds a map, so the resolve kernel needs its map code.
+    pub fn binds_maps(&self) -> bool {
+        self.layers.iter().any(|layer| layer.maps.iter().any(|&m| m != NONE))
+    }
+
     /// Which of these stacks may resolve to another material than `before`'s did, at some
     /// pixel: every one when there was nothing before, or when pixels map to stacks differently
     /// or the layers read other channels; otherwise those whose layers differ, bit for bit.

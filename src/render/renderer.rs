@@ -113,13 +113,13 @@ impl Renderer {
         kernels: KernelSource,
     ) -> Result<Renderer> {
         let (width, height) = (gbuffer.width, gbuffer.height);
-        let Specialization { model, accumulate, product, lobes } = kernels.specialization();
+        let Specialization { model, accumulate, product, lobes, maps } = kernels.specialization();
         let gpu_gbuffer = GpuGBuffer::upload(ctx, gbuffer)?;
         let targets = Targets::new(ctx, width, height, accumulate)?;
         let gpu_environment = upload_environment(ctx, environment, sampling)?;
         let lists = PixelLists::new(ctx, gbuffer)?;
         let kernels = kernels.wait(ctx)?;
-        let resolve = ResolvePass::new(ctx, kernels.resolve);
+        let resolve = ResolvePass::new(ctx, kernels.resolve, maps);
         let relight = RelightPass::new(
             ctx,
             kernels.relight,
@@ -881,6 +881,8 @@ pub struct Specialization {
     pub product: bool,
     /// The lobes of the scene's stacks ([`PackedStacks::lobes`]).
     pub lobes: LobesPresent,
+    /// Whether the scene's stacks bind maps ([`PackedStacks::binds_maps`]), for the resolve.
+    pub maps: bool,
 }
 
 impl Default for Specialization {
@@ -891,6 +893,7 @@ impl Default for Specialization {
             accumulate: Accumulate::default(),
             product: Sampling::default().product_kernel(),
             lobes: LobesPresent::default(),
+            maps: false,
         }
     }
 }
@@ -906,6 +909,7 @@ impl Specialization {
             accumulate: kernel_accumulate(wanted, settings.noise),
             product: settings.sampling.product_kernel(),
             lobes: scene.stacks.lobes(),
+            maps: scene.stacks.binds_maps(),
         }
     }
 }
@@ -922,11 +926,11 @@ impl Kernels {
     /// Compiles them, the relight kernel (by far the slowest) first. Pipeline creation is
     /// thread-safe, so this may run on any thread while the context is used on others.
     pub fn compile(ctx: &Context, specialization: Specialization) -> Result<Kernels> {
-        let Specialization { model, accumulate, product, lobes } = specialization;
+        let Specialization { model, accumulate, product, lobes, maps } = specialization;
         Ok(Kernels {
             specialization,
             relight: RelightPass::pipeline(ctx, &model, accumulate, product, lobes)?,
-            resolve: ResolvePass::pipeline(ctx)?,
+            resolve: ResolvePass::pipeline(ctx, maps)?,
             finalize: FinalizePass::pipeline(ctx)?,
         })
     }

@@ -168,6 +168,7 @@ fn stacks_renderer(
         model,
         product: sampling.product_kernel(),
         lobes: packed.lobes(),
+        maps: packed.binds_maps(),
         ..Specialization::default()
     });
     let mut renderer = Renderer::with_kernels(ctx, gbuffer, environment, sampling, kernels)?;

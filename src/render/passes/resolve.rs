@@ -56,6 +56,8 @@ struct Stacks {
 pub struct ResolvePass {
     ctx: Context,
     pipeline: ComputePipeline,
+    /// Whether `pipeline` has the map code ([`ResolvePass::pipeline`]).
+    maps: bool,
     stacks: Option<Stacks>,
     /// The stacks whose resolve the resolved image holds, once a resolve of them has run: a
     /// later resolve skips the pixels of every stack unchanged since.
@@ -68,14 +70,15 @@ pub struct ResolvePass {
 }
 
 impl ResolvePass {
-    /// The pass, with its pipeline compiled by [`ResolvePass::pipeline`].
-    pub fn new(ctx: &Context, pipeline: ComputePipeline) -> ResolvePass {
-        ResolvePass { ctx: ctx.clone(), pipeline, stacks: None, resolved: None, changed: None, list: None }
+    /// The pass, with its pipeline compiled by [`ResolvePass::pipeline`] for `maps`.
+    pub fn new(ctx: &Context, pipeline: ComputePipeline, maps: bool) -> ResolvePass {
+        ResolvePass { ctx: ctx.clone(), pipeline, maps, stacks: None, resolved: None, changed: None, list: None }
     }
 
-    /// Compiles `resolve.comp`.
-    pub fn pipeline(ctx: &Context) -> Result<ComputePipeline> {
-        ComputePipeline::new(ctx, &shaders::RESOLVE, INTERFACE.sets, INTERFACE.push_size())
+    /// Compiles `resolve.comp`, with the code that multiplies values by their maps when `maps`
+    /// (stacks that bind none resolve the same without it, faster).
+    pub fn pipeline(ctx: &Context, maps: bool) -> Result<ComputePipeline> {
+        ComputePipeline::specialized(ctx, &shaders::RESOLVE, INTERFACE.sets, INTERFACE.push_size(), &[maps as u32])
     }
 
     /// Uploads `packed` (and the g-buffer channels it reads) and binds it for [`Self::record`],
@@ -91,6 +94,8 @@ impl ResolvePass {
         lists: &PixelLists,
     ) -> Result<()> {
         let (width, height) = (targets.resolved.width, targets.resolved.height);
+        let maps = packed.binds_maps();
+        let respecialized = if maps != self.maps { Some(ResolvePass::pipeline(ctx, maps)?) } else { None };
         let changed_stacks = packed.changed_since(self.resolved.take().as_ref());
         let (stack_index, channels) = gbuffer.resolve_inputs(ctx, packed)?;
         let (list, pixels) =
@@ -111,7 +116,7 @@ impl ResolvePass {
             self.changed = Some(Buffer::storage(ctx, (width as u64 * height as u64).div_ceil(32) * 4)?);
         }
         let changed = self.changed.as_ref().expect("just made");
-        let set = self.pipeline.bind(
+        let set = respecialized.as_ref().unwrap_or(&self.pipeline).bind(
             0,
             &[
                 Binding::Image(&stack_index.image),
@@ -124,6 +129,10 @@ impl ResolvePass {
             ],
         )?;
         self.stacks = Some(Stacks { _stacks: stacks, _layers: layers, set, pixels: pixels as u32 });
+        if let Some(pipeline) = respecialized {
+            self.pipeline = pipeline;
+            self.maps = maps;
+        }
         Ok(())
     }
 
