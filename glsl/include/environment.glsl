@@ -21,7 +21,9 @@ layout(set = 1, binding = 0, rgba32f) uniform readonly image2D env_texels;
 layout(set = 1, binding = 1, rgba32f) uniform readonly image2D env_buckets;
 // The same tables' plain CDF values, for the rare bucket that spans several intervals.
 layout(set = 1, binding = 2, r32f) uniform readonly image2D env_cdf;
-layout(set = 1, binding = 3, std430) readonly buffer EnvInfo {
+// The sizes, read alike by every invocation: a uniform block, which a CPU driver loads once for
+// all lanes where it reads a storage buffer lane by lane.
+layout(set = 1, binding = 3, std140) uniform EnvInfo {
     uint env_width;    // texels
     uint env_height;
     uint env_block_x;  // texels per cell
@@ -32,11 +34,6 @@ layout(set = 1, binding = 3, std430) readonly buffer EnvInfo {
     uint env_coarse_columns;  // coarse cells, each a block of cells
     uint env_coarse_rows;
     uint env_product_ratio_row;  // env_product_cdf's row of cluster 0's ratios
-    // Product sampling's lookups (Product::index), which spare each sample integer divisions
-    // that lavapipe runs lane by lane: each texel column's coarse column; each texel row's
-    // coarse row times env_coarse_columns; then per coarse cell its columns of cells
-    // c0 | c1 << 16, its rows r0 | r1 << 16, and where its table starts, x | row << 16.
-    uint env_product_index[];
 };
 // Product sampling (src/environment/product.rs): the bucket entries and CDFs, laid out as
 // env_buckets and env_cdf are, of one table per cluster of normals over the coarse cells (row k
@@ -50,6 +47,16 @@ layout(set = 1, binding = 5, r32f) uniform readonly image2D env_product_cdf;
 // the cells of row `row` that the target of bucket k of the span from c0 can fall in. 1×1 when
 // off.
 layout(set = 1, binding = 6, r32ui) uniform readonly uimage2D env_product_spans;
+// Product sampling's lookups (Product::index), which spare each sample integer divisions that
+// lavapipe runs lane by lane, word i at texel (i % 1024, i / 1024) (INDEX_WIDTH in
+// src/environment/gpu.rs): each texel column's coarse column; each texel row's coarse row times
+// env_coarse_columns; then per coarse cell its columns of cells c0 | c1 << 16, its rows
+// r0 | r1 << 16, and where its table starts, x | row << 16. 1×1 when off.
+layout(set = 1, binding = 7, r32ui) uniform readonly uimage2D env_product_index;
+
+uint env_product_word(uint i) {
+    return imageLoad(env_product_index, ivec2(i & 1023u, i >> 10)).x;
+}
 
 // v = acos(d.y)/π, computed as atan2(|d.xz|, d.y)/π: the same angle for a unit d, but well
 // conditioned near the poles, and accurate where a driver's acos is only approximate.
@@ -186,7 +193,7 @@ uint env_cluster(vec3 n) {
 
 // The ratio of `cluster`'s product pdf to the global pdf at texel `at`.
 float env_product_ratio(uint cluster, uvec2 at) {
-    uint c = env_product_index[at.x] + env_product_index[env_width + at.y];
+    uint c = env_product_word(at.x) + env_product_word(env_width + at.y);
     return imageLoad(env_product_cdf, ivec2(c, env_product_ratio_row + cluster)).x;
 }
 
@@ -228,9 +235,9 @@ vec3 env_sample_product(uint cluster, vec2 u, out uvec2 at) {
     uint c = env_product_search(ivec2(0, cluster), cells, u.x, bounds);
     float ux = env_rescale(u.x, bounds);
     uint span_at = env_width + env_height + 3u * c;
-    uint columns = env_product_index[span_at];
-    uint rows = env_product_index[span_at + 1u];
-    uint table = env_product_index[span_at + 2u];
+    uint columns = env_product_word(span_at);
+    uint rows = env_product_word(span_at + 1u);
+    uint table = env_product_word(span_at + 2u);
     uint c0 = columns & 0xffffu;
     uint c1 = columns >> 16;
     uint r0 = rows & 0xffffu;

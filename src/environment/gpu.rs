@@ -19,7 +19,14 @@ pub struct GpuEnvironment {
     pub product_buckets: Image,
     pub product_cdf: Image,
     pub product_spans: Image,
+    /// [`Product::index`] as `env_product_index` reads it ([`INDEX_WIDTH`] words a row), or a
+    /// 1×1 placeholder.
+    pub product_index: Image,
 }
+
+/// Words per row of the `env_product_index` image: a power of two, so a word's texel is found
+/// by a mask and a shift.
+pub const INDEX_WIDTH: u32 = 1024;
 
 /// The environment samplers the kernels bound to an environment run, which decide the tables
 /// it needs.
@@ -68,7 +75,7 @@ impl GpuEnvironment {
             Samplers::Global => None,
             Samplers::Product(p) | Samplers::Mixture(p) => Some(p),
         };
-        let (product_buckets, product_cdf, product_spans) = match product {
+        let (product_buckets, product_cdf, product_spans, product_index) = match product {
             Some(p) => {
                 let (width, bucket_rows, cdf_rows) = p.table_size();
                 if width > max || cdf_rows > max {
@@ -85,27 +92,28 @@ impl GpuEnvironment {
                     Image::filled(ctx, vk::Format::R32_UINT, p.columns, p.rows, |out: &mut [u32]| {
                         out.copy_from_slice(&p.spans)
                     })?,
+                    index_image(ctx, &p.index)?,
                 )
             }
-            None => (placeholder(ctx, rgba)?, placeholder(ctx, r32)?, placeholder(ctx, vk::Format::R32_UINT)?),
+            None => (
+                placeholder(ctx, rgba)?,
+                placeholder(ctx, r32)?,
+                placeholder(ctx, vk::Format::R32_UINT)?,
+                placeholder(ctx, vk::Format::R32_UINT)?,
+            ),
         };
-        // EnvInfo: the header, then env_product_index (one unused word when off, as a buffer
-        // may not be empty).
+        // EnvInfo: the header, with the product tables' sizes when they are on.
         let mut info = vec![0u32; 10];
         info[..8].copy_from_slice(&distribution.header());
-        match product {
-            Some(p) => {
-                info[6..10].copy_from_slice(&[p.grid, p.coarse_columns, p.coarse_rows, p.ratio_row()]);
-                info.extend(&p.index);
-            }
-            None => info.push(0),
+        if let Some(p) = product {
+            info[6..10].copy_from_slice(&[p.grid, p.coarse_columns, p.coarse_rows, p.ratio_row()]);
         }
-        let info = Buffer::with_data(ctx, bytemuck::cast_slice(&info))?;
-        Ok(GpuEnvironment { texels, buckets, cdf, info, product_buckets, product_cdf, product_spans })
+        let info = Buffer::uniform(ctx, bytemuck::cast_slice(&info))?;
+        Ok(GpuEnvironment { texels, buckets, cdf, info, product_buckets, product_cdf, product_spans, product_index })
     }
 
     /// The bindings of descriptor set 1, in `environment.glsl` order.
-    pub fn bindings(&self) -> [Binding<'_>; 7] {
+    pub fn bindings(&self) -> [Binding<'_>; 8] {
         [
             Binding::Image(&self.texels),
             Binding::Image(&self.buckets),
@@ -114,8 +122,18 @@ impl GpuEnvironment {
             Binding::Image(&self.product_buckets),
             Binding::Image(&self.product_cdf),
             Binding::Image(&self.product_spans),
+            Binding::Image(&self.product_index),
         ]
     }
+}
+
+/// `index` in an R32_UINT image, [`INDEX_WIDTH`] words a row (the last row padded with zeros).
+fn index_image(ctx: &Context, index: &[u32]) -> Result<Image> {
+    let rows = (index.len() as u32).div_ceil(INDEX_WIDTH).max(1);
+    Image::filled(ctx, vk::Format::R32_UINT, INDEX_WIDTH, rows, |out: &mut [u32]| {
+        out.fill(0);
+        out[..index.len()].copy_from_slice(index);
+    })
 }
 
 /// A 1×1 image of zeros bound where a table is not needed.
@@ -124,11 +142,12 @@ fn placeholder(ctx: &Context, format: vk::Format) -> Result<Image> {
 }
 
 /// The layout of descriptor set 1.
-pub const SET_LAYOUT: [BindingKind; 7] = [
+pub const SET_LAYOUT: [BindingKind; 8] = [
     BindingKind::StorageImage,
     BindingKind::StorageImage,
     BindingKind::StorageImage,
-    BindingKind::StorageBuffer,
+    BindingKind::UniformBuffer,
+    BindingKind::StorageImage,
     BindingKind::StorageImage,
     BindingKind::StorageImage,
     BindingKind::StorageImage,

@@ -103,6 +103,12 @@ impl Buffer {
         Buffer::storage(ctx, data.len() as u64)?.fill(ctx, data)
     }
 
+    /// A device-local uniform buffer holding `data`.
+    pub fn uniform(ctx: &Context, data: &[u8]) -> Result<Buffer> {
+        let usage = vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+        Buffer::new(ctx, data.len() as u64, usage, false)?.fill(ctx, data)
+    }
+
     /// A device-local vertex buffer holding `data`.
     pub fn vertices(ctx: &Context, data: &[u8]) -> Result<Buffer> {
         let usage = vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;

@@ -13,6 +13,9 @@ use std::sync::Arc;
 pub enum BindingKind {
     StorageImage,
     StorageBuffer,
+    /// A small block of constants every invocation reads alike: a CPU driver loads a uniform
+    /// buffer's values once for all lanes, where it reads a storage buffer lane by lane.
+    UniformBuffer,
     /// An array of this many combined image samplers (the bake's textures).
     Textures(u32),
 }
@@ -22,6 +25,7 @@ impl BindingKind {
         match self {
             BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
             BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
+            BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
             BindingKind::Textures(_) => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
         }
     }
@@ -197,7 +201,7 @@ impl DescriptorSet {
         bindings: &[Binding],
     ) -> Result<DescriptorSet> {
         let device = &shared.device;
-        let sizes: Vec<_> = [BindingKind::StorageImage, BindingKind::StorageBuffer]
+        let sizes: Vec<_> = [BindingKind::StorageImage, BindingKind::StorageBuffer, BindingKind::UniformBuffer]
             .into_iter()
             .filter_map(|kind| {
                 let count = kinds.iter().filter(|k| **k == kind).count() as u32;
@@ -235,14 +239,11 @@ impl DescriptorSet {
             .iter()
             .enumerate()
             .map(|(i, b)| {
-                assert_eq!(
-                    kinds[i],
-                    match b {
-                        Binding::Image(_) => BindingKind::StorageImage,
-                        Binding::Buffer(_) => BindingKind::StorageBuffer,
-                    },
-                    "binding {i} has the wrong kind"
-                );
+                let fits = match b {
+                    Binding::Image(_) => kinds[i] == BindingKind::StorageImage,
+                    Binding::Buffer(_) => matches!(kinds[i], BindingKind::StorageBuffer | BindingKind::UniformBuffer),
+                };
+                assert!(fits, "binding {i} has the wrong kind");
                 let write = vk::WriteDescriptorSet::default()
                     .dst_set(set)
                     .dst_binding(i as u32)
