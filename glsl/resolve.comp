@@ -25,27 +25,19 @@ layout(set = 0, binding = 0, r32ui) uniform readonly uimage2D stack_index;
 // The g-buffer channels the look uses, masks and map channels alike, one layer each.
 layout(set = 0, binding = 1, r32f) uniform readonly image2DArray channels;
 
-struct Stack {
-    uint first_layer;
-    uint layer_count;
-    uint pad0;
-    uint pad1;
-};
-layout(set = 0, binding = 2, std430) readonly buffer Stacks {
-    Stack stacks[];
-};
+// The stacks, one texel each (GpuStack): first layer, layer count. Stack s is texel
+// (s % 1024, s / 1024).
+layout(set = 0, binding = 2, rgba32ui) uniform readonly uimage2D stacks;
+// The layers, eleven texels each (GpuLayer, 176 bytes): the layer's own material (five texels,
+// float bits, as Params::to_gpu lays it out); per value, the layer of `channels` it is
+// multiplied by, or −1 (five); then its mask (a layer of `channels`, or −1), invert, opacity
+// (float bits) and whether it binds a map. 64 layers a row. Images rather than storage buffers,
+// which a CPU driver reads lane by lane.
+layout(set = 0, binding = 3, rgba32ui) uniform readonly uimage2D layers;
 
-struct Layer {
-    vec4 params[5];   // the layer's own material, as Params::to_gpu lays it out
-    ivec4 maps[5];    // per value of params: the layer of `channels` it is multiplied by, or −1
-    int mask;         // layer of `channels`, or −1 for none
-    uint invert;
-    float opacity;
-    uint pad;
-};
-layout(set = 0, binding = 3, std430) readonly buffer Layers {
-    Layer layers[];
-};
+uvec4 layer_texel(uint layer, uint k) {
+    return imageLoad(layers, ivec2((layer & 63u) * 11u + k, layer >> 6));
+}
 
 layout(set = 0, binding = 4, rgba32f) uniform image2DArray resolved;
 // The pixels to resolve, as a list (pixel_list.glsl).
@@ -69,9 +61,9 @@ float channel(ivec2 pixel, int layer) {
 // The layer's material at this pixel: its values, each bound one times its map.
 void layer_material(uint index, ivec2 pixel, out vec4 p[5]) {
     for (int k = 0; k < 5; k++) {
-        p[k] = layers[index].params[k];
+        p[k] = uintBitsToFloat(layer_texel(index, uint(k)));
         if (MAPS != 0u) {
-            ivec4 maps = layers[index].maps[k];
+            ivec4 maps = ivec4(layer_texel(index, 5u + uint(k)));
             for (int c = 0; c < 4; c++) {
                 if (maps[c] >= 0) {
                     p[k][c] *= channel(pixel, maps[c]);
@@ -88,14 +80,16 @@ void main() {
     }
     ivec2 size = imageSize(stack_index);
     ivec2 pixel = unpack_pixel(imageLoad(pixels, list_texel(entry, size.x)).r);
-    Stack stack = stacks[imageLoad(stack_index, pixel).r];
+    uint s = imageLoad(stack_index, pixel).r;
+    uvec2 stack = imageLoad(stacks, ivec2(s & 1023u, s >> 10)).xy;  // first layer, layer count
     vec4 p[5];
-    layer_material(stack.first_layer, pixel, p);
-    for (uint i = 1u; i < stack.layer_count; i++) {
-        uint index = stack.first_layer + i;
-        int mask = layers[index].mask;
+    layer_material(stack.x, pixel, p);
+    for (uint i = 1u; i < stack.y; i++) {
+        uint index = stack.x + i;
+        uvec4 blend = layer_texel(index, 10u);  // mask, invert, opacity, mapped
+        int mask = int(blend.x);
         float m = mask >= 0 ? channel(pixel, mask) : 1.0;
-        float w = clamp(layers[index].opacity * (layers[index].invert != 0u ? 1.0 - m : m), 0.0, 1.0);
+        float w = clamp(uintBitsToFloat(blend.z) * (blend.y != 0u ? 1.0 - m : m), 0.0, 1.0);
         vec4 q[5];
         layer_material(index, pixel, q);
         for (int k = 0; k < 5; k++) {

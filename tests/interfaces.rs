@@ -420,11 +420,11 @@ fn a_mismatched_interface_is_reported() {
     assert!(problems.iter().any(|p| p.contains("binding 0")), "{problems:?}");
     assert!(problems.iter().any(|p| p.contains("binding 7 is bound by Rust")), "{problems:?}");
     // A buffer struct with a different stride.
-    let problems = with(resolve::INTERFACE, |i| {
-        const SHORT_LAYER: GlslStruct = GlslStruct { size: 160, ..resolve::INTERFACE.structs[1] };
-        i.structs = &[SHORT_LAYER];
+    let problems = with(common::probes::BRDF_PROBE, |i| {
+        const SHORT_RECORD: GlslStruct = GlslStruct { size: 80, ..common::probes::BRDF_PROBE.structs[0] };
+        i.structs = &[SHORT_RECORD];
     });
-    assert!(problems.iter().any(|p| p.contains("step 176 bytes")), "{problems:?}");
+    assert!(problems.iter().any(|p| p.contains("step 96 bytes")), "{problems:?}");
     // A vertex attribute of the wrong width.
     let bake_vertex = lookdev::asset::bake::INTERFACES[0];
     let mut attributes = bake_vertex.vertex_inputs.to_vec();

@@ -214,7 +214,7 @@ pub struct Image {
 /// Bytes per texel of the formats lookdev uses.
 pub fn texel_size(format: vk::Format) -> u64 {
     match format {
-        vk::Format::R32G32B32A32_SFLOAT => 16,
+        vk::Format::R32G32B32A32_SFLOAT | vk::Format::R32G32B32A32_UINT => 16,
         vk::Format::R32G32_SFLOAT | vk::Format::R32G32_UINT | vk::Format::R16G16B16A16_SFLOAT => 8,
         vk::Format::R32_SFLOAT
         | vk::Format::R32_UINT

@@ -13,7 +13,8 @@ use std::path::Path;
 /// No channel: a layer without a mask, or a value bound to no map.
 const NONE: i32 = -1;
 
-/// One layer as `resolve.comp` reads it (std430, 176 bytes).
+/// One layer as `resolve.comp` reads it: eleven RGBA32_UINT texels of its `layers` image, in
+/// this order, floats as their bits (texels 0–4 `params`, 5–9 `maps`, 10 the rest).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GpuLayer {
@@ -28,7 +29,10 @@ pub struct GpuLayer {
     pub pad: u32,
 }
 
-crate::glsl_struct!(GpuLayer as "Layer", 176 bytes { params @ 0, maps @ 80, mask @ 160, invert @ 164, opacity @ 168, pad @ 172 });
+const _: () = assert!(std::mem::size_of::<GpuLayer>() == LAYER_TEXELS * 16);
+
+/// Texels of `resolve.comp`'s `layers` image per layer.
+pub const LAYER_TEXELS: usize = 11;
 
 impl GpuLayer {
     /// A lone layer of the default parameters, for objects no stack covers.
@@ -152,7 +156,8 @@ pub fn unused_stack_warnings(look: &Look, object_ids: &[u32], gbuffer_name: &Pat
         .collect()
 }
 
-/// One stack as `resolve.comp` reads it: its first layer and how many layers it has.
+/// One stack as `resolve.comp` reads it, one RGBA32_UINT texel of its `stacks` image: its first
+/// layer and how many layers it has.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GpuStack {
@@ -162,7 +167,7 @@ pub struct GpuStack {
     pub pad1: u32,
 }
 
-crate::glsl_struct!(GpuStack as "Stack", 16 bytes { first_layer @ 0, layer_count @ 4, pad0 @ 8, pad1 @ 12 });
+const _: () = assert!(std::mem::size_of::<GpuStack>() == 16);
 
 /// Every stack the g-buffer's objects need, ready to upload.
 #[derive(Clone, Debug, PartialEq)]

@@ -10,7 +10,7 @@ use crate::gbuffer::gpu::GpuGBuffer;
 use crate::gpu::{
     shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, GlslLayout, Image, Interface,
 };
-use crate::material::stack::{GpuLayer, GpuStack, PackedStacks};
+use crate::material::stack::{PackedStacks, LAYER_TEXELS};
 use crate::Result;
 use ash::vk;
 
@@ -19,19 +19,22 @@ use ash::vk;
 pub const SET: [BindingKind; 7] = [
     BindingKind::StorageImage,
     BindingKind::StorageImage,
-    BindingKind::StorageBuffer,
-    BindingKind::StorageBuffer,
+    BindingKind::StorageImage,
+    BindingKind::StorageImage,
     BindingKind::StorageImage,
     BindingKind::StorageImage,
     BindingKind::StorageBuffer,
 ];
 
-/// What `resolve.comp` and the host agree on: the push constants, and the stacks and layers as
-/// [`PackedStacks`] holds them.
-pub const INTERFACE: Interface = Interface {
-    structs: &[GpuStack::GLSL, GpuLayer::GLSL],
-    ..Interface::compute(&shaders::RESOLVE, &[&SET], Some(ResolvePush::GLSL))
-};
+/// What `resolve.comp` and the host agree on: the push constants. The stacks and layers are
+/// images of their [`GpuStack`](crate::material::stack::GpuStack) and
+/// [`GpuLayer`](crate::material::stack::GpuLayer) texels.
+pub const INTERFACE: Interface = Interface::compute(&shaders::RESOLVE, &[&SET], Some(ResolvePush::GLSL));
+
+/// Stacks per row of the `stacks` image, and layers per row of the `layers` image, as
+/// `resolve.comp` finds them (powers of two: a mask and a shift).
+const STACKS_PER_ROW: usize = 1024;
+const LAYERS_PER_ROW: usize = 64;
 
 /// `resolve.comp`'s push constants: the entries of the pixel list one dispatch resolves.
 #[repr(C)]
@@ -45,8 +48,8 @@ crate::glsl_struct!(ResolvePush as "Pass", 8 bytes { first @ 0, end @ 4 });
 
 /// The stacks on the GPU, held while the set points at them.
 struct Stacks {
-    _stacks: Buffer,
-    _layers: Buffer,
+    _stacks: Image,
+    _layers: Image,
     set: DescriptorSet,
     /// Entries of the pixel list to resolve.
     pixels: u32,
@@ -110,8 +113,8 @@ impl ResolvePass {
                     (list, pixels.len())
                 }
             };
-        let stacks = Buffer::with_data(ctx, bytemuck::cast_slice(&packed.stacks))?;
-        let layers = Buffer::with_data(ctx, bytemuck::cast_slice(&packed.layers))?;
+        let stacks = texel_image(ctx, bytemuck::cast_slice(&packed.stacks), STACKS_PER_ROW)?;
+        let layers = texel_image(ctx, bytemuck::cast_slice(&packed.layers), LAYERS_PER_ROW * LAYER_TEXELS)?;
         if self.changed.is_none() {
             self.changed = Some(Buffer::storage(ctx, (width as u64 * height as u64).div_ceil(32) * 4)?);
         }
@@ -121,8 +124,8 @@ impl ResolvePass {
             &[
                 Binding::Image(&stack_index.image),
                 Binding::Image(channels),
-                Binding::Buffer(&stacks),
-                Binding::Buffer(&layers),
+                Binding::Image(&stacks),
+                Binding::Image(&layers),
                 Binding::Image(&targets.resolved),
                 Binding::Image(list),
                 Binding::Buffer(changed),
@@ -171,6 +174,16 @@ impl ResolvePass {
             .collect();
         Ok(changed_indices(&words, pixels))
     }
+}
+
+/// `texels` in an RGBA32_UINT image `per_row` texels wide, the last row padded with zeros: what
+/// `resolve.comp` reads lane by lane from a storage buffer, it gathers from an image.
+fn texel_image(ctx: &Context, texels: &[[u32; 4]], per_row: usize) -> Result<Image> {
+    let rows = texels.len().div_ceil(per_row).max(1) as u32;
+    Image::filled(ctx, vk::Format::R32G32B32A32_UINT, per_row as u32, rows, |out: &mut [[u32; 4]]| {
+        out.fill([0; 4]);
+        out[..texels.len()].copy_from_slice(texels);
+    })
 }
 
 /// The entries of `covered` (packed pixels of a `width`-wide image) whose stack, by
