@@ -31,7 +31,7 @@ layout(set = 0, binding = 2, rgba32ui) uniform readonly uimage2D stacks;
 // The layers, eleven texels each (GpuLayer, 176 bytes): the layer's own material (five texels,
 // float bits, as Params::to_gpu lays it out); per value, the layer of `channels` it is
 // multiplied by, or −1 (five); then its mask (a layer of `channels`, or −1), invert, opacity
-// (float bits) and whether it binds a map. 64 layers a row. Images rather than storage buffers,
+// (float bits) and padding. 64 layers a row. Images rather than storage buffers,
 // which a CPU driver reads lane by lane.
 layout(set = 0, binding = 3, rgba32ui) uniform readonly uimage2D layers;
 
@@ -86,7 +86,7 @@ void main() {
     layer_material(stack.x, pixel, p);
     for (uint i = 1u; i < stack.y; i++) {
         uint index = stack.x + i;
-        uvec4 blend = layer_texel(index, 10u);  // mask, invert, opacity, mapped
+        uvec4 blend = layer_texel(index, 10u);  // mask, invert, opacity, pad
         int mask = int(blend.x);
         float m = mask >= 0 ? channel(pixel, mask) : 1.0;
         float w = clamp(uintBitsToFloat(blend.z) * (blend.y != 0u ? 1.0 - m : m), 0.0, 1.0);

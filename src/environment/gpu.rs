@@ -92,7 +92,7 @@ impl GpuEnvironment {
                     Image::filled(ctx, vk::Format::R32_UINT, p.columns, p.rows, |out: &mut [u32]| {
                         out.copy_from_slice(&p.spans)
                     })?,
-                    index_image(ctx, &p.index)?,
+                    Image::rows_of(ctx, vk::Format::R32_UINT, INDEX_WIDTH, &p.index)?,
                 )
             }
             None => (
@@ -125,15 +125,6 @@ impl GpuEnvironment {
             Binding::Image(&self.product_index),
         ]
     }
-}
-
-/// `index` in an R32_UINT image, [`INDEX_WIDTH`] words a row (the last row padded with zeros).
-fn index_image(ctx: &Context, index: &[u32]) -> Result<Image> {
-    let rows = (index.len() as u32).div_ceil(INDEX_WIDTH).max(1);
-    Image::filled(ctx, vk::Format::R32_UINT, INDEX_WIDTH, rows, |out: &mut [u32]| {
-        out.fill(0);
-        out[..index.len()].copy_from_slice(index);
-    })
 }
 
 /// A 1×1 image of zeros bound where a table is not needed.

@@ -245,6 +245,17 @@ impl Image {
         Ok(image)
     }
 
+    /// An image `per_row` texels wide holding `texels` row by row, the last row padded with
+    /// zeros: a table a kernel indexes with a mask and a shift (`per_row` a power of two, or a
+    /// multiple of a record's texels).
+    pub fn rows_of<T: bytemuck::Pod>(ctx: &Context, format: vk::Format, per_row: u32, texels: &[T]) -> Result<Image> {
+        let rows = (texels.len() as u32).div_ceil(per_row).max(1);
+        Image::filled(ctx, format, per_row, rows, |out: &mut [T]| {
+            out.fill(T::zeroed());
+            out[..texels.len()].copy_from_slice(texels);
+        })
+    }
+
     /// An RGBA8 storage image holding sRGB-encoded display pixels, which can also be sampled
     /// through [`Image::srgb_view`] (the viewer shows it that way).
     pub fn display(ctx: &Context, width: u32, height: u32) -> Result<Image> {

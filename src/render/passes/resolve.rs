@@ -33,8 +33,8 @@ pub const INTERFACE: Interface = Interface::compute(&shaders::RESOLVE, &[&SET], 
 
 /// Stacks per row of the `stacks` image, and layers per row of the `layers` image, as
 /// `resolve.comp` finds them (powers of two: a mask and a shift).
-const STACKS_PER_ROW: usize = 1024;
-const LAYERS_PER_ROW: usize = 64;
+const STACKS_PER_ROW: u32 = 1024;
+const LAYERS_PER_ROW: u32 = 64;
 
 /// `resolve.comp`'s push constants: the entries of the pixel list one dispatch resolves.
 #[repr(C)]
@@ -113,8 +113,11 @@ impl ResolvePass {
                     (list, pixels.len())
                 }
             };
-        let stacks = texel_image(ctx, bytemuck::cast_slice(&packed.stacks), STACKS_PER_ROW)?;
-        let layers = texel_image(ctx, bytemuck::cast_slice(&packed.layers), LAYERS_PER_ROW * LAYER_TEXELS)?;
+        // Each GpuStack is one RGBA32_UINT texel, each GpuLayer LAYER_TEXELS.
+        let rgba = vk::Format::R32G32B32A32_UINT;
+        let stacks = Image::rows_of::<[u32; 4]>(ctx, rgba, STACKS_PER_ROW, bytemuck::cast_slice(&packed.stacks))?;
+        let layers_per_row = LAYERS_PER_ROW * LAYER_TEXELS as u32;
+        let layers = Image::rows_of::<[u32; 4]>(ctx, rgba, layers_per_row, bytemuck::cast_slice(&packed.layers))?;
         if self.changed.is_none() {
             self.changed = Some(Buffer::storage(ctx, (width as u64 * height as u64).div_ceil(32) * 4)?);
         }
@@ -174,16 +177,6 @@ impl ResolvePass {
             .collect();
         Ok(changed_indices(&words, pixels))
     }
-}
-
-/// `texels` in an RGBA32_UINT image `per_row` texels wide, the last row padded with zeros: what
-/// `resolve.comp` reads lane by lane from a storage buffer, it gathers from an image.
-fn texel_image(ctx: &Context, texels: &[[u32; 4]], per_row: usize) -> Result<Image> {
-    let rows = texels.len().div_ceil(per_row).max(1) as u32;
-    Image::filled(ctx, vk::Format::R32G32B32A32_UINT, per_row as u32, rows, |out: &mut [[u32; 4]]| {
-        out.fill([0; 4]);
-        out[..texels.len()].copy_from_slice(texels);
-    })
 }
 
 /// The entries of `covered` (packed pixels of a `width`-wide image) whose stack, by
