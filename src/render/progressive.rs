@@ -15,12 +15,17 @@ const TARGET_DISPATCH: Duration = Duration::from_millis(500);
 /// dispatches rather than four, each of which pays the per-pixel set-up again.
 const MIN_SPEED: f64 = 5e6;
 
-/// Samples per pixel of the first dispatch over `pixels` pixels: what a device does in an
-/// eighth of [`TARGET_DISPATCH`] at `pace` samples a second (the renderer's last timed
-/// dispatch, set-up included, which understates its speed), or at [`MIN_SPEED`] before one;
-/// at least 1 and at most `spp`.
+/// Samples per pixel of the first dispatch over `pixels` pixels. With `pace`, the samples a
+/// second of the renderer's last timed dispatch (set-up included, which understates its
+/// speed): all `spp` when that pace does them within [`TARGET_DISPATCH`], since every pass
+/// costs a set-up of a couple of samples on a CPU driver; otherwise what the device does in an
+/// eighth of it, at that pace or at [`MIN_SPEED`] before one. At least 1 and at most `spp`.
 fn first_batch(pixels: usize, spp: u32, pace: Option<f64>) -> u32 {
-    let samples = pace.unwrap_or(MIN_SPEED) * (TARGET_DISPATCH / 8).as_secs_f64() / pixels.max(1) as f64;
+    let pixels = pixels.max(1) as f64;
+    if pace.is_some_and(|pace| pixels * spp as f64 / pace <= TARGET_DISPATCH.as_secs_f64()) {
+        return spp.max(1);
+    }
+    let samples = pace.unwrap_or(MIN_SPEED) * (TARGET_DISPATCH / 8).as_secs_f64() / pixels;
     (samples as u32).clamp(1, spp.max(1))
 }
 
@@ -102,9 +107,11 @@ mod tests {
         assert_eq!(first_batch(0, 4, None), 4);
         assert_eq!(first_batch(100, 0, None), 1);
         // Once the renderer has timed a dispatch, its pace: the ball's 296,856 pixels at
-        // 16 M samples a second take 3 samples in 62.5 ms; a slower pace than the assumed
-        // least, fewer.
-        assert_eq!(first_batch(296_856, 16, Some(16e6)), 3);
+        // 16 M samples a second do 16 samples in 0.30 s, within the target, so in one
+        // dispatch; 64 would take 1.19 s, so the first holds the 3 done in 62.5 ms. A slower
+        // pace than the assumed least, fewer.
+        assert_eq!(first_batch(296_856, 16, Some(16e6)), 16);
+        assert_eq!(first_batch(296_856, 64, Some(16e6)), 3);
         assert_eq!(first_batch(42_208, 64, Some(1e6)), 1);
     }
 }
