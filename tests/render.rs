@@ -359,8 +359,8 @@ fn renders_are_deterministic() {
 }
 
 /// An accumulation's first dispatch is sized by the pace the renderer last measured: at a pace
-/// that does every sample in the first eighth of a dispatch's target, one dispatch; at a crawl,
-/// one sample first. Either way the image is the same, and the accumulation measures a pace.
+/// that does every sample within a dispatch's target, one dispatch; at a crawl, one sample
+/// first. Either way the image is the same, and the accumulation measures a pace.
 #[test]
 fn the_first_dispatch_follows_the_measured_pace() {
     let ctx = common::gpu::context();
@@ -378,6 +378,34 @@ fn the_first_dispatch_follows_the_measured_pace() {
     assert!(slow >= 2, "one sample first, then the rest: {slow} dispatches");
     assert!(fast_image == slow_image, "the split changes no bits");
     assert!(measured.is_some_and(|p| p > 1.0), "the accumulation measured its pace: {measured:?}");
+    common::gpu::finish(ctx);
+}
+
+/// Reading the radiance finalizes only the rows that changed since they were last finalized,
+/// with the display's exposure and tone map: the display pixels the viewer shows stay as they
+/// were made, and the radiance is that of the current sums.
+#[test]
+fn reading_the_radiance_keeps_the_display_and_finalizes_what_changed() {
+    let ctx = common::gpu::context();
+    let (gbuffer, look, _) = shaderball_scene(64);
+    let env = Environment::studio();
+    let mut r = renderer(&ctx, &gbuffer, &env, &look, Lighting::default());
+    r.render_samples(2).unwrap();
+    let two = r.read_radiance().unwrap();
+    r.finalize_rows(0, r.height, 1.5, Tonemap::Aces).unwrap();
+    let shown = r.display_image().read(&ctx).unwrap();
+    assert!(r.read_radiance().unwrap() == two, "the same sums, the same radiance");
+    assert!(r.display_image().read(&ctx).unwrap() == shown, "the display as it was made");
+    // Rows 0..32 relit, 0..16 finalized: the read finalizes 16..32, as a finalize of all does.
+    r.render_rows(0, 32, 1).unwrap();
+    r.finalize_rows(0, 16, 1.5, Tonemap::Aces).unwrap();
+    let read = r.read_radiance().unwrap();
+    assert!(read != two, "rows relit since read anew");
+    let shown = r.display_image().read(&ctx).unwrap();
+    r.finalize_rows(0, r.height, 1.5, Tonemap::Aces).unwrap();
+    assert!(r.read_radiance().unwrap() == read, "every changed row was finalized before the read");
+    assert!(r.display_image().read(&ctx).unwrap() == shown, "with the display's exposure and tone map");
+    drop(r);
     common::gpu::finish(ctx);
 }
 

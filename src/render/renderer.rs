@@ -18,6 +18,7 @@ use crate::shading::model::Model;
 use crate::shading::tonemap::Tonemap;
 use crate::Result;
 use ash::vk;
+use std::cell::{Cell, RefCell};
 
 pub use super::passes::relight::{Accumulate, RelightPush, LOBES};
 pub use super::passes::RESOLVED_LAYERS;
@@ -87,6 +88,13 @@ pub struct Renderer {
     /// Pixel samples a second of its last dispatch that [`super::progressive::accumulate`]
     /// timed, set-up included: what sizes the next accumulation's first dispatch.
     pace: Option<f64>,
+    /// Rows whose radiance image holds their current sums (finalized since they last changed),
+    /// so that reading the radiance need not finalize them again: on a CPU driver a finalize of
+    /// the whole image costs about as much as a sample of every covered pixel.
+    finalized_rows: RefCell<Vec<bool>>,
+    /// The exposure and tone map the display image was last made with, which a read of the
+    /// radiance keeps when it finalizes rows.
+    display_settings: Cell<(f32, Tonemap)>,
 }
 
 impl Renderer {
@@ -157,6 +165,8 @@ impl Renderer {
             sampling,
             lobes,
             pace: None,
+            finalized_rows: RefCell::new(vec![false; height as usize]),
+            display_settings: Cell::new((0.0, Tonemap::Linear)),
         };
         // Kernels compiled for another estimator's sampler are replaced, not used.
         if product != sampling.product_kernel() {
@@ -279,6 +289,7 @@ impl Renderer {
     /// Starts a new accumulation with everything unchanged.
     pub fn restart(&mut self) {
         self.row_samples.fill(0);
+        self.finalized_rows.get_mut().fill(false);
         self.restarted = None;
         for (y, active) in self.row_active.iter_mut().enumerate() {
             *active = self.lists.covered.row_len(y as u32);
@@ -456,6 +467,7 @@ impl Renderer {
             return Ok(Some(0.0));
         }
         let end = first_row.saturating_add(rows).min(self.height);
+        self.finalized_rows.get_mut()[first_row.min(end) as usize..end as usize].fill(false);
         if self.restarted.as_ref().is_some_and(|r| (0..self.height).any(|y| r.lags(y, &self.row_samples))) {
             return self.render_restarted(first_row, end, count);
         }
@@ -547,6 +559,7 @@ impl Renderer {
         if self.row_samples.iter().any(|&n| n > 0) {
             return Err(crate::Error::gpu("a preview comes before the first pass of an accumulation"));
         }
+        self.finalized_rows.get_mut().fill(false);
         let mut pushes = self.background_pushes(0, self.height);
         let blocks = self.width.div_ceil(block) * self.height.div_ceil(block);
         pushes.push(RelightPush { block, ..self.push(Source::Preview, 0, blocks, 0, 1) });
@@ -617,6 +630,8 @@ impl Renderer {
     /// preview, when there is one; a dispatch per run of rows of either kind.
     pub fn record_finalize(&self, cmd: vk::CommandBuffer, first_row: u32, rows: u32, exposure: f32, tonemap: Tonemap) {
         let end = first_row + rows.min(self.height.saturating_sub(first_row));
+        self.finalized_rows.borrow_mut()[first_row.min(end) as usize..end as usize].fill(true);
+        self.display_settings.set((exposure, tonemap));
         let block_of = |row: u32| match self.preview {
             Some(block) if self.row_samples[row as usize] == 0 => block,
             _ => 1,
@@ -655,11 +670,17 @@ impl Renderer {
 
     /// Linear radiance per pixel, row 0 at the top: rgb composited over the background with
     /// alpha 1, or, with the background off, premultiplied by coverage with alpha = coverage.
+    /// Rows not finalized since they last changed are finalized first, their display pixels
+    /// with the exposure and tone map of the last finalize, so what the viewer shows stays.
     pub fn read_radiance(&self) -> Result<Vec<[f32; 4]>> {
         self.check_rendered()?;
         let staging = Buffer::staging(&self.ctx, self.targets.radiance.byte_size())?;
+        let stale: Vec<(u32, u32)> = runs_of_false(&self.finalized_rows.borrow());
+        let (exposure, tonemap) = self.display_settings.get();
         self.ctx.run(|cmd| {
-            self.record_finalize(cmd, 0, self.height, 0.0, Tonemap::Linear);
+            for &(first, rows) in &stale {
+                self.record_finalize(cmd, first, rows, exposure, tonemap);
+            }
             self.targets.radiance.record_read(cmd, &staging);
             Ok(())
         })?;
@@ -847,6 +868,23 @@ fn upload_environment(ctx: &Context, environment: &Environment, sampling: Sampli
     GpuEnvironment::upload_with(ctx, environment, &distribution, samplers)
 }
 
+/// The runs of `false` in `flags`: (first index, length) each.
+fn runs_of_false(flags: &[bool]) -> Vec<(u32, u32)> {
+    let mut runs = Vec::new();
+    let mut start = None;
+    for (i, &flag) in flags.iter().chain([&true]).enumerate() {
+        match (flag, start) {
+            (false, None) => start = Some(i),
+            (true, Some(first)) => {
+                runs.push((first as u32, (i - first) as u32));
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    runs
+}
+
 /// Pixels restarted alone, catching up with their rows.
 struct Restarted {
     /// The pixels, row by row.
@@ -965,5 +1003,17 @@ impl KernelSource<'_> {
             KernelSource::Compile(specialization) => Kernels::compile(ctx, specialization),
             KernelSource::Pending(pending) => pending.wait(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::runs_of_false;
+
+    #[test]
+    fn runs_of_false_are_found_at_either_end_and_between() {
+        assert_eq!(runs_of_false(&[]), vec![]);
+        assert_eq!(runs_of_false(&[true, true]), vec![]);
+        assert_eq!(runs_of_false(&[false, false, true, false, true, true, false]), vec![(0, 2), (3, 1), (6, 1)]);
     }
 }

@@ -8,8 +8,9 @@
 //! band by band: no row ever shows the state before the change.
 //!
 //! An edit of the materials alone restarts only the pixels it changed, with no preview: the
-//! bands relight those pixels alone, the first sweep one sample each, until they have caught up
-//! with the rest (docs/commands.md#edit-local-re-convergence).
+//! bands relight those pixels alone, the first sweep one sample each, the next up to
+//! [`CATCH_UP_SAMPLES`], until they have caught up with the rest
+//! (docs/commands.md#edit-local-re-convergence).
 
 use crate::render::Renderer;
 use crate::shading::tonemap::Tonemap;
@@ -56,6 +57,11 @@ pub fn read_again(shown: u32, now: u32, target: u32) -> bool {
 /// Samples per band once the first pass has landed: fewer, longer dispatches amortise each
 /// pass's per-pixel set-up, which on a CPU driver costs about as much as a sample.
 const SAMPLES_PER_BAND: u32 = 4;
+/// Samples per band of the pixels an edit restarted alone, once they have all had one (and per
+/// dispatch when a save catches them up): more than [`SAMPLES_PER_BAND`], since they are a
+/// share of the image and each pass's set-up costs a couple of samples on a CPU driver. So they
+/// catch up in one more sweep, at the rest's count, band by band.
+pub const CATCH_UP_SAMPLES: u32 = 16;
 /// What a pixel's background costs in the preview, as a share of a relit sample.
 const PREVIEW_BACKGROUND_SHARE: f64 = 0.1;
 
@@ -194,8 +200,8 @@ impl Progressive {
     }
 
     /// Relights the next band of the restarted pixels ([`Renderer::restart_pixels`]), which
-    /// have `theirs` samples: one sample a band until they have all had one, then a few, never
-    /// past the rest's count or `target`.
+    /// have `theirs` samples: one sample a band until they have all had one, then up to
+    /// [`CATCH_UP_SAMPLES`], never past the rest's count or `target`.
     fn step_region(
         &mut self,
         renderer: &mut Renderer,
@@ -212,7 +218,7 @@ impl Progressive {
             }
             self.region_cursor = first;
         }
-        let count = if self.region_swept { SAMPLES_PER_BAND.min(target.saturating_sub(theirs)).max(1) } else { 1 };
+        let count = if self.region_swept { CATCH_UP_SAMPLES.min(target.saturating_sub(theirs)).max(1) } else { 1 };
         let per_row = if self.region_row_seconds > 0.0 { self.region_row_seconds } else { self.row_seconds };
         let wanted =
             if per_row > 0.0 { (self.budget.as_secs_f64() / (per_row * count as f64)) as u32 } else { MIN_BAND_ROWS };

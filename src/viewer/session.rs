@@ -26,8 +26,6 @@ use std::time::{Duration, Instant};
 
 /// Environments kept loaded, so that undoing a switch does not read the file again.
 const KEPT_ENVIRONMENTS: usize = 3;
-/// Samples a dispatch adds to restarted pixels when a save catches them up.
-const CATCH_UP_SAMPLES: u32 = 16;
 
 /// What the renderer was last given.
 struct Shown {
@@ -647,7 +645,8 @@ impl Session {
         while let Some((first, rows)) = self.renderer.lagging_rows() {
             // Restarted pixels stop at their rows' counts, so may take several samples at once;
             // lagging rows are one band's samples behind.
-            let count = if self.renderer.restarted_region().is_some() { CATCH_UP_SAMPLES } else { 1 };
+            let count =
+                if self.renderer.restarted_region().is_some() { super::progressive::CATCH_UP_SAMPLES } else { 1 };
             self.renderer.render_rows(first, rows, count)?;
             self.renderer.finalize_rows(first, rows, exposure, tonemap)?;
         }
@@ -667,8 +666,6 @@ impl Session {
         match format {
             OutputFormat::Exr => {
                 let radiance = self.renderer.read_radiance()?;
-                // Reading radiance remade the display pixels in linear; show them as before.
-                self.renderer.finalize_rows(0, height, settings.exposure, settings.tonemap)?;
                 let environment = self.environments.iter().find(|(p, _)| *p == self.shown.environment).map(|(_, e)| e);
                 let metadata = environment
                     .map(|e| output::Metadata::of_render(self.document.look(), &settings, e))
@@ -788,12 +785,9 @@ impl Session {
         crate::render::aov::layers(aovs, &sources)
     }
 
-    /// A's linear radiance, as `read_radiance` gives it, with the display pixels shown again.
+    /// A's linear radiance, as `read_radiance` gives it.
     pub fn radiance(&mut self) -> Result<Vec<[f32; 4]>> {
-        let radiance = self.renderer.read_radiance()?;
-        let settings = self.document.settings();
-        self.renderer.finalize_rows(0, self.height(), settings.exposure, settings.tonemap)?;
-        Ok(radiance)
+        self.renderer.read_radiance()
     }
 }
 
@@ -808,7 +802,6 @@ impl Session {
         let settings = self.document.settings().clone();
         let radiance = self.renderer.read_radiance()?;
         output::check_finite(Path::new("snapshot"), &radiance)?;
-        // Reading radiance remade the display pixels in linear; this remakes them as shown.
         let display = self.renderer.read_display(settings.exposure, settings.tonemap)?;
         let environment = self.environments.iter().find(|(p, _)| *p == self.shown.environment).map(|(_, e)| e);
         let metadata =
