@@ -559,6 +559,7 @@ impl Renderer {
         if self.row_samples.iter().any(|&n| n > 0) {
             return Err(crate::Error::gpu("a preview comes before the first pass of an accumulation"));
         }
+        self.finalize.prepare_preview(&self.ctx, &self.gbuffer, &self.targets)?;
         self.finalized_rows.get_mut().fill(false);
         let mut pushes = self.background_pushes(0, self.height);
         let blocks = self.width.div_ceil(block) * self.height.div_ceil(block);
@@ -969,7 +970,7 @@ impl Kernels {
             specialization,
             relight: RelightPass::pipeline(ctx, &model, accumulate, product, lobes)?,
             resolve: ResolvePass::pipeline(ctx, maps)?,
-            finalize: FinalizePass::pipeline(ctx)?,
+            finalize: FinalizePass::pipeline(ctx, false)?,
         })
     }
 }

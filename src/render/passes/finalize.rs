@@ -40,14 +40,33 @@ crate::glsl_struct!(FinalizePush as "Finalize", 24 bytes {
 });
 
 pub struct FinalizePass {
+    /// Without the preview's code ([`FinalizePass::pipeline`]).
     pipeline: ComputePipeline,
     set: DescriptorSet,
+    /// With it, and its set: made for the first preview ([`FinalizePass::prepare_preview`]).
+    preview: Option<(ComputePipeline, DescriptorSet)>,
 }
 
 impl FinalizePass {
-    /// The pass, with its pipeline compiled by [`FinalizePass::pipeline`], bound to `targets`.
+    /// The pass, with its pipeline compiled by [`FinalizePass::pipeline`] without the
+    /// preview's code, bound to `targets`.
     pub fn new(pipeline: ComputePipeline, gbuffer: &GpuGBuffer, targets: &Targets) -> Result<FinalizePass> {
-        let set = pipeline.bind(
+        let set = FinalizePass::bind(&pipeline, gbuffer, targets)?;
+        Ok(FinalizePass { pipeline, set, preview: None })
+    }
+
+    /// Compiles and binds the pipeline with the preview's code, unless it is made.
+    pub fn prepare_preview(&mut self, ctx: &Context, gbuffer: &GpuGBuffer, targets: &Targets) -> Result<()> {
+        if self.preview.is_none() {
+            let pipeline = FinalizePass::pipeline(ctx, true)?;
+            let set = FinalizePass::bind(&pipeline, gbuffer, targets)?;
+            self.preview = Some((pipeline, set));
+        }
+        Ok(())
+    }
+
+    fn bind(pipeline: &ComputePipeline, gbuffer: &GpuGBuffer, targets: &Targets) -> Result<DescriptorSet> {
+        pipeline.bind(
             0,
             &[
                 Binding::Image(&targets.accumulation),
@@ -57,18 +76,24 @@ impl FinalizePass {
                 Binding::Image(&targets.display),
                 Binding::Image(&gbuffer.object_ids),
             ],
-        )?;
-        Ok(FinalizePass { pipeline, set })
+        )
     }
 
-    /// Compiles `finalize.comp`.
-    pub fn pipeline(ctx: &Context) -> Result<ComputePipeline> {
-        ComputePipeline::new(ctx, &shaders::FINALIZE, INTERFACE.sets, INTERFACE.push_size())
+    /// Compiles `finalize.comp`, with the preview's interpolation when `preview` (which costs
+    /// the other rows too on a CPU driver).
+    pub fn pipeline(ctx: &Context, preview: bool) -> Result<ComputePipeline> {
+        ComputePipeline::specialized(ctx, &shaders::FINALIZE, INTERFACE.sets, INTERFACE.push_size(), &[preview as u32])
     }
 
-    /// Records the pass over `width` pixels of the rows `push` names.
+    /// Records the pass over `width` pixels of the rows `push` names. A preview's rows
+    /// (`block` > 1) need [`FinalizePass::prepare_preview`] first.
     pub fn record(&self, cmd: vk::CommandBuffer, width: u32, push: &FinalizePush) {
         let rows = push.end_row.saturating_sub(push.first_row);
-        self.pipeline.dispatch(cmd, &[&self.set], bytemuck::bytes_of(push), groups(width, rows));
+        let (pipeline, set) = match (&self.preview, push.block > 1) {
+            (Some((pipeline, set)), true) => (pipeline, set),
+            (None, true) => panic!("a preview's rows are finalized after prepare_preview()"),
+            (_, false) => (&self.pipeline, &self.set),
+        };
+        pipeline.dispatch(cmd, &[set], bytemuck::bytes_of(push), groups(width, rows));
     }
 }
