@@ -55,7 +55,7 @@ pub fn read_again(shown: u32, now: u32, target: u32) -> bool {
     now != shown && (now < shown || now >= target || now.checked_ilog2() > shown.checked_ilog2())
 }
 /// Samples per band once the first pass has landed: fewer, longer dispatches amortise each
-/// pass's per-pixel set-up, which on a CPU driver costs about as much as a sample.
+/// pass's per-pixel set-up, which on a CPU driver costs about as much as a couple of samples.
 const SAMPLES_PER_BAND: u32 = 4;
 /// Samples per band of the pixels an edit restarted alone, once they have all had one (and per
 /// dispatch when a save catches them up): more than [`SAMPLES_PER_BAND`], since they are a

@@ -786,7 +786,7 @@ impl Session {
     }
 
     /// A's linear radiance, as `read_radiance` gives it.
-    pub fn radiance(&mut self) -> Result<Vec<[f32; 4]>> {
+    pub fn radiance(&self) -> Result<Vec<[f32; 4]>> {
         self.renderer.read_radiance()
     }
 }
