@@ -65,7 +65,11 @@ impl Checker<'_> {
         let has_explicit_coverage = explicit_coverage.is_some();
         let coverage = explicit_coverage.unwrap_or_else(|| raw_normal.iter().map(|&n| default_coverage(n)).collect());
 
-        let normal = self.normals(&raw_normal, &coverage, has_explicit_coverage)?;
+        let object_id = match raw.channels.get(OBJECT_ID_CHANNEL) {
+            Some(samples) => self.object_ids(samples)?,
+            None => vec![0; raw_normal.len()],
+        };
+        let normal = self.normals(&raw_normal, &coverage, has_explicit_coverage, &object_id)?;
         let view = match &raw_view {
             Some(raw_view) => self.views(raw_view)?,
             None => vec![Vec3::from(DEFAULT_VIEW); normal.len()],
@@ -74,10 +78,6 @@ impl Checker<'_> {
         let tangent = match &raw_tangent {
             Some(raw_tangent) => self.tangents(&normal, raw_tangent, &coverage),
             None => normal.iter().map(|n| stable_tangent(n.to_array())).collect(),
-        };
-        let object_id = match raw.channels.get(OBJECT_ID_CHANNEL) {
-            Some(samples) => self.object_ids(samples)?,
-            None => vec![0; normal.len()],
         };
         let masks = self.prefixed(&raw.channels, MASK_PREFIX)?;
         let mut maps = self.prefixed(&raw.channels, MAP_PREFIX)?;
@@ -208,24 +208,43 @@ impl Checker<'_> {
 
     /// Unit normals. Covered pixels must have a usable normal; uncovered ones keep theirs where
     /// it is usable and get the placeholder otherwise.
-    fn normals(&mut self, raw: &[Vec3], coverage: &[f32], explicit_coverage: bool) -> Result<Vec<Vec3>> {
+    /// Unit normals. A covered pixel's normal shorter than [`MIN_NORMAL_LENGTH`] is an error,
+    /// but where the pixel borders another object: a renderer's filtered normal pass averages
+    /// the two objects' normals there, which can all but cancel. Such a pixel takes the normal of
+    /// a neighbour of its own object (of any covered neighbour if it has none), with a warning.
+    fn normals(&mut self, raw: &[Vec3], coverage: &[f32], explicit_coverage: bool, ids: &[u32]) -> Result<Vec<Vec3>> {
         let mut non_finite = Offenders::default();
         let mut too_short = Offenders::default();
+        let mut filled = 0usize;
         let mut renormalised = 0usize;
         let mut normals = Vec::with_capacity(raw.len());
+        let usable = |n: Vec3| n.is_finite() && n.length() > MIN_NORMAL_LENGTH;
         for (i, (&n, &a)) in raw.iter().zip(coverage).enumerate() {
             let length = n.length();
-            let usable = n.is_finite() && length > MIN_NORMAL_LENGTH;
+            let mut normal = if usable(n) { n / length } else { Vec3::from(PLACEHOLDER_NORMAL) };
             if a > 0.0 {
                 if !n.is_finite() {
                     non_finite.add(i);
-                } else if !usable {
-                    too_short.add(i);
+                } else if !usable(n) {
+                    match self.edge_normal(i, raw, coverage, ids) {
+                        Some(borrowed) => {
+                            normal = borrowed;
+                            filled += 1;
+                        }
+                        None => too_short.add(i),
+                    }
                 } else if (length - 1.0).abs() > NORMAL_LENGTH_TOLERANCE {
                     renormalised += 1;
                 }
             }
-            normals.push(if usable { n / length } else { Vec3::from(PLACEHOLDER_NORMAL) });
+            normals.push(normal);
+        }
+        if filled > 0 {
+            self.warn(format!(
+                "{} shorter than {MIN_NORMAL_LENGTH} where objects meet (a filtered normal pass averages their \
+                 normals there) took a neighbour's normal",
+                counted(filled, "normal")
+            ));
         }
         if non_finite.count > 0 {
             let pixel = if explicit_coverage { "covered pixel" } else { "pixel" };
@@ -250,6 +269,29 @@ impl Checker<'_> {
             ));
         }
         Ok(normals)
+    }
+
+    /// Where covered pixel `i` borders another object, the unit normal of a neighbour of its own
+    /// object, else of any covered neighbour, with a usable normal.
+    fn edge_normal(&self, i: usize, raw: &[Vec3], coverage: &[f32], ids: &[u32]) -> Option<Vec3> {
+        let covered: Vec<usize> = self.neighbours(i, raw.len()).filter(|&j| coverage[j] > 0.0).collect();
+        if covered.iter().all(|&j| ids[j] == ids[i]) {
+            return None;
+        }
+        let usable = |&&j: &&usize| raw[j].is_finite() && raw[j].length() > MIN_NORMAL_LENGTH;
+        let own = covered.iter().filter(usable).find(|&&j| ids[j] == ids[i]);
+        own.or(covered.iter().find(usable)).map(|&j| raw[j].normalize())
+    }
+
+    /// The pixels around pixel `i` of an image of `pixels` pixels, up to eight, row by row.
+    fn neighbours(&self, i: usize, pixels: usize) -> impl Iterator<Item = usize> {
+        let width = self.width as isize;
+        let height = (pixels / self.width) as isize;
+        let (x, y) = ((i % self.width) as isize, (i / self.width) as isize);
+        (-1..=1).flat_map(move |dy| (-1..=1).map(move |dx| (x + dx, y + dy))).filter_map(move |(nx, ny)| {
+            let inside = (0..width).contains(&nx) && (0..height).contains(&ny) && (nx, ny) != (x, y);
+            inside.then_some((ny * width + nx) as usize)
+        })
     }
 
     /// Unit view vectors; every pixel needs one, background included, since the background shows
@@ -520,6 +562,40 @@ mod tests {
         let mut channels = normals(4);
         channels.push(("RY", Samples::F32(vec![0.0; 1])));
         assert!(build(Path::new("g.exr"), raw(2, 2, channels)).is_ok());
+    }
+
+    /// Three pixels in a row, all covered, the middle one's normal all but cancelled.
+    fn short_middle_normal(ids: [u32; 3]) -> RawImage {
+        raw(
+            3,
+            1,
+            vec![
+                ("N.X", Samples::F32(vec![0.6, 0.0, 0.0])),
+                ("N.Y", Samples::F32(vec![0.0, 0.0, 0.6])),
+                ("N.Z", Samples::F32(vec![0.8, 0.1, 0.8])),
+                ("A", Samples::F32(vec![1.0; 3])),
+                ("objectId", Samples::U32(ids.to_vec())),
+            ],
+        )
+    }
+
+    #[test]
+    fn short_normals_where_objects_meet_take_their_own_objects_neighbours() {
+        let (g, warnings) = build(Path::new("g.exr"), short_middle_normal([1, 2, 2])).unwrap();
+        assert_eq!(g.normal[1], [0.0, 0.6, 0.8], "the neighbour of its own object, object 2");
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert!(warnings[0].contains("1 normal shorter than 0.5 where objects meet"), "{}", warnings[0]);
+        let (g, _) = build(Path::new("g.exr"), short_middle_normal([1, 3, 2])).unwrap();
+        assert_eq!(g.normal[1], [0.6, 0.0, 0.8], "no neighbour of its own object: the first covered one");
+    }
+
+    #[test]
+    fn short_normals_inside_one_object_stay_errors() {
+        let message = error_of(short_middle_normal([2, 2, 2]));
+        assert!(
+            message.contains("normals shorter than 0.5 where coverage A > 0, at 1 pixel (first at x=1, y=0)"),
+            "{message}"
+        );
     }
 
     #[test]
