@@ -16,6 +16,7 @@ layout(location = 2) in vec4 world_tangent;
 layout(location = 3) in vec4 color;
 layout(location = SLOT_MASK) flat in uint slot_mask;
 layout(location = SLOT_TEXCOORDS) in vec4 slot_uv[SLOT_PAIRS];
+layout(location = TRIANGLE_LOCATION) flat in uint triangle;
 
 // A slot's texel, or white where the slot is empty. Sampled before any fragment is discarded, so
 // that every lane of a quad has its derivatives; the branch is the same for the whole draw.
@@ -27,6 +28,7 @@ layout(location = 1) out vec4 out_tangent;      // xyz; w = bitangent sign
 layout(location = 2) out vec4 out_view;         // xyz
 layout(location = 3) out uvec2 out_ids;         // object id, material index + 1
 layout(location = 4) out vec4 out_color;        // COLOR_0
+layout(location = 5) out uvec4 out_surface;     // the world position's bits, the triangle's index
 
 // The least N·V a shading normal keeps.
 const float MIN_FACING = 0.01;
@@ -71,4 +73,5 @@ void main() {
     out_view = vec4(view, 0.0);
     out_ids = uvec2(draw.object_id, draw.material + 1u);
     out_color = color;
+    out_surface = uvec4(floatBitsToUint(world_position), triangle);
 }

@@ -20,9 +20,12 @@ layout(location = 2) out vec4 world_tangent;
 layout(location = 3) out vec4 out_color;
 layout(location = SLOT_MASK) flat out uint slot_mask;
 layout(location = SLOT_TEXCOORDS) out vec4 slot_uv[SLOT_PAIRS];
+// The triangle's index in the vertex buffer: draws are not indexed, three vertices a triangle.
+layout(location = TRIANGLE_LOCATION) flat out uint triangle;
 
 void main() {
     world_position = position;
+    triangle = uint(gl_VertexIndex) / 3u;
     world_normal = normal;
     world_tangent = tangent;
     out_color = color;

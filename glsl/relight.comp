@@ -32,6 +32,10 @@ layout(constant_id = 7) const uint VARIANCE_AOV = 0u;
 // Whether the environment sample is drawn by the product tables (--sampling product): a
 // constant, so that the kernel of each estimator holds only its own sampler.
 layout(constant_id = 8) const uint PRODUCT_SAMPLING = 0u;
+// The side of the g-buffer's visibility grid (docs/formats.md#visibility): both strategies' samples
+// carry light only along directions the pixel's surface sees the environment. 0 without
+// visibility: every direction above the horizon is seen, and the image bound is a placeholder.
+layout(constant_id = 11) const uint VISIBILITY_SIDE = 0u;
 
 #include "common.glsl"
 #include "material.glsl"
@@ -40,6 +44,7 @@ layout(constant_id = 8) const uint PRODUCT_SAMPLING = 0u;
 #include "sobol.glsl"
 #include "environment.glsl"
 #include "pixel_list.glsl"
+#include "visibility.glsl"
 
 // Layer 0: N.xyz and coverage A; layer 1: V.xyz; layer 2: T.xyz (unit, orthogonal to N).
 layout(set = 0, binding = 0, rgba32f) uniform readonly image2DArray surface;
@@ -64,6 +69,12 @@ layout(set = 0, binding = 8, r32ui) uniform readonly uimage2D restarted;
 layout(set = 0, binding = 9, std430) buffer Active {
     uint rows[];
 } still_active;
+// With VISIBILITY_SIDE, the visibility words of every pixel in turn (row-major), four a texel, so
+// that a pixel's words share cache lines; VISIBILITY_ROW texels a row.
+layout(set = 0, binding = 10, rgba32ui) uniform readonly uimage2D visibility;
+const uint VISIBILITY_ROW = 4096u;
+// Texels of visibility a pixel has.
+const uint VISIBILITY_TEXELS = (VISIBILITY_SIDE * VISIBILITY_SIDE + 127u) / 128u;
 
 const int LOBE_DIFFUSE = 0;
 const int LOBE_SPECULAR = 1;
@@ -100,6 +111,26 @@ vec3 to_environment(vec3 d) {
                 d.x * pass.sin_rotation + d.z * pass.cos_rotation);
 }
 
+// R_y(rotation)·d: environment to world space.
+vec3 from_environment(vec3 d) {
+    return vec3(d.x * pass.cos_rotation + d.z * pass.sin_rotation, d.y,
+                -d.x * pass.sin_rotation + d.z * pass.cos_rotation);
+}
+
+// Whether the environment is seen along d (environment space) from the surface of the pixel
+// whose visibility starts at texel `first`: its bit on the visibility grid, which is fixed in
+// world space. Always, without visibility.
+bool seen(uint first, vec3 d) {
+    if (VISIBILITY_SIDE == 0u) {
+        return true;
+    }
+    uint cell = visibility_cell(from_environment(d), VISIBILITY_SIDE);
+    uint word = cell >> 5u;
+    uint t = first + (word >> 2u);
+    uvec4 texel = imageLoad(visibility, ivec2(int(t % VISIBILITY_ROW), int(t / VISIBILITY_ROW)));
+    return ((texel[word & 3u] >> (cell & 31u)) & 1u) != 0u;
+}
+
 // With product tables (PRODUCT_SAMPLING), a pixel samples the environment from its normal's
 // cluster's table alone (q = 1 of env_sample_mixture, which the kernel does not call: a SIMD
 // driver would run the global sampler masked beside the cluster's for every sample).
@@ -119,13 +150,13 @@ vec4 environment_texel(uint cluster, vec2 uv) {
 
 // One MIS estimate of reflected radiance toward the view; the frame (fx, fy, fn) is the shading
 // frame expressed in environment space, so no per-sample rotation is needed.
-vec3 estimate(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, uint cluster, vec2 u_env, vec2 u_brdf) {
+vec3 estimate(uint visibility_first, Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, uint cluster, vec2 u_env, vec2 u_brdf) {
     vec3 result = vec3(0.0);
 
     vec4 texel;
     vec3 d = sample_environment(cluster, u_env, texel);
     vec3 l = vec3(dot(d, fx), dot(d, fy), dot(d, fn));
-    if (l.z > 0.0 && texel.a > 0.0) {
+    if (l.z > 0.0 && texel.a > 0.0 && seen(visibility_first, d)) {
         HalfVector hv = make_half_vector(s, l, view.v);
         vec3 f = disney_brdf(s, view, l, hv);
         float pdf_brdf = brdf_pdf(choice, view, l, hv);
@@ -136,8 +167,8 @@ vec3 estimate(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, 
     if (l.z > 0.0) {
         HalfVector hv = make_half_vector(s, l, view.v);
         float pdf_brdf = brdf_pdf(choice, view, l, hv);
-        if (pdf_brdf > 0.0) {
-            d = normalize(l.x * fx + l.y * fy + l.z * fn);
+        d = normalize(l.x * fx + l.y * fy + l.z * fn);
+        if (pdf_brdf > 0.0 && seen(visibility_first, d)) {
             texel = environment_texel(cluster, env_direction_to_uv(d));
             vec3 f = disney_brdf(s, view, l, hv);
             result += f * (l.z * mis_weight_over_pdf(pdf_brdf, texel.a)) * texel.rgb;
@@ -148,7 +179,7 @@ vec3 estimate(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, 
 
 // The same estimate as `estimate`, bit for bit, with each lobe's share of it beside: the
 // lobes' sum is the total up to float rounding.
-vec3 estimate_lobes(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, uint cluster, vec2 u_env, vec2 u_brdf,
+vec3 estimate_lobes(uint visibility_first, Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, uint cluster, vec2 u_env, vec2 u_brdf,
                     out vec3 shares[4]) {
     vec3 result = vec3(0.0);
     for (int k = 0; k < 4; k++) {
@@ -159,7 +190,7 @@ vec3 estimate_lobes(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec
     vec4 texel;
     vec3 d = sample_environment(cluster, u_env, texel);
     vec3 l = vec3(dot(d, fx), dot(d, fy), dot(d, fn));
-    if (l.z > 0.0 && texel.a > 0.0) {
+    if (l.z > 0.0 && texel.a > 0.0 && seen(visibility_first, d)) {
         HalfVector hv = make_half_vector(s, l, view.v);
         BrdfLobes b = disney_lobes(s, view, l, hv);
         float pdf_brdf = brdf_pdf(choice, view, l, hv);
@@ -175,8 +206,8 @@ vec3 estimate_lobes(Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec
     if (l.z > 0.0) {
         HalfVector hv = make_half_vector(s, l, view.v);
         float pdf_brdf = brdf_pdf(choice, view, l, hv);
-        if (pdf_brdf > 0.0) {
-            d = normalize(l.x * fx + l.y * fy + l.z * fn);
+        d = normalize(l.x * fx + l.y * fy + l.z * fn);
+        if (pdf_brdf > 0.0 && seen(visibility_first, d)) {
             texel = environment_texel(cluster, env_direction_to_uv(d));
             BrdfLobes b = disney_lobes(s, view, l, hv);
             float w = l.z * mis_weight_over_pdf(pdf_brdf, texel.a);
@@ -270,20 +301,22 @@ void relight(ivec2 pixel, ivec2 size) {
         vec3 fy = to_environment(b);
         vec3 fn = to_environment(n);
         uint cluster = environment_cluster(fn);
-        uint pixel_seed = hash_combine(hash_u32(pass.seed), uint(pixel.y) * uint(size.x) + uint(pixel.x));
+        uint pixel_index = uint(pixel.y) * uint(size.x) + uint(pixel.x);
+        uint pixel_seed = hash_combine(hash_u32(pass.seed), pixel_index);
+        uint visibility_first = pixel_index * VISIBILITY_TEXELS;
         uint env_seed = hash_combine(pixel_seed, 0x454e56u);
         uint brdf_seed = hash_combine(pixel_seed, 0x425244u);
         for (uint i = pass.first_sample; i < end_sample; i++) {
             vec3 x;
             if (LOBE_AOVS != 0u) {
                 vec3 shares[4];
-                x = emission + estimate_lobes(s, choice, view_terms, fx, fy, fn, cluster, sobol_owen_2d(i, env_seed),
+                x = emission + estimate_lobes(visibility_first, s, choice, view_terms, fx, fy, fn, cluster, sobol_owen_2d(i, env_seed),
                                               sobol_owen_2d(i, brdf_seed), shares);
                 for (int k = 0; k < 4; k++) {
                     lobes[k] += shares[k];
                 }
             } else {
-                x = emission + estimate(s, choice, view_terms, fx, fy, fn, cluster, sobol_owen_2d(i, env_seed),
+                x = emission + estimate(visibility_first, s, choice, view_terms, fx, fy, fn, cluster, sobol_owen_2d(i, env_seed),
                                         sobol_owen_2d(i, brdf_seed));
             }
             sum.rgb += x;

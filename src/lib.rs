@@ -24,6 +24,7 @@ pub mod timings;
 #[cfg(feature = "viewer")]
 pub mod viewer;
 pub mod viewer_state;
+pub mod visibility;
 
 pub use error::{number_text, printable, Error, ErrorKind, Result};
 

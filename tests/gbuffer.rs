@@ -1048,3 +1048,63 @@ fn a_few_normals_facing_away_shade_black_with_a_warning() {
     assert_eq!(warnings.len(), 1, "{warnings:?}");
     assert!(warnings[0].contains("at 2 pixels of") && warnings[0].contains("shade black"), "{}", warnings[0]);
 }
+
+// ---------------------------------------------------------------------------------------------
+// Visibility channels (docs/formats.md#visibility)
+
+#[test]
+fn visibility_channels_round_trip_word_for_word() {
+    use lookdev::visibility::{Grid, Visibility};
+    let mut g = GBuffer::sphere(8, 8);
+    let grid = Grid::new(16).unwrap();
+    let words = (0..g.pixel_count() * grid.words()).map(|i| (i as u32).wrapping_mul(2_654_435_761)).collect();
+    g.visibility = Some(Visibility { grid, words });
+    let path = scratch("visibility-round-trip.exr");
+    g.write(&path).unwrap();
+    let (read, warnings) = read_ok(&path);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(read.visibility, g.visibility);
+    // Every word is its own uint channel.
+    let names: Vec<String> = read_channel_names(&path);
+    assert!((0..8).all(|w| names.contains(&format!("visibility.{w}"))), "{names:?}");
+}
+
+fn read_channel_names(path: &Path) -> Vec<String> {
+    let image = read_all_flat_layers_from_file(path).unwrap();
+    image.layer_data[0].channel_data.list.iter().map(|c| c.name.to_string()).collect()
+}
+
+#[test]
+fn bad_visibility_channels_are_named_errors() {
+    let disc = Disc::new(4, 4);
+    let words = |name: &'static str| uint(name, (0..16).map(|i| i * 7));
+    let with = |extra: Vec<Channel>| {
+        let mut channels = disc.half_normals();
+        channels.extend(extra);
+        channels
+    };
+    let cases: Vec<(&str, Vec<Channel>, Vec<&str>)> = vec![
+        (
+            "half",
+            with(vec![words("visibility.0"), half("visibility.1", (0..16).map(|_| 1.0))]),
+            vec!["channel visibility.1 is not uint"],
+        ),
+        (
+            "three words",
+            with(vec![words("visibility.0"), words("visibility.1"), words("visibility.2")]),
+            vec!["found 3 with indices 0, 1, 2", "K = 2, 8, 32, 128"],
+        ),
+        ("a gap", with(vec![words("visibility.0"), words("visibility.2")]), vec!["found 2 with indices 0, 2"]),
+        (
+            "a name",
+            with(vec![words("visibility.sun"), words("visibility.1")]),
+            vec!["channel visibility.sun: a visibility channel is named by its word's index"],
+        ),
+        ("padded", with(vec![words("visibility.00"), words("visibility.1")]), vec!["channel visibility.00"]),
+    ];
+    for (what, channels, phrases) in cases {
+        let path = scratch(&format!("visibility-{}.exr", what.replace(' ', "-")));
+        write_exr(&path, disc.size(), channels, Compression::ZIP16, &[]);
+        read_err(&path, &phrases);
+    }
+}

@@ -23,6 +23,8 @@ layout(set = 0, binding = 0) uniform sampler2D textures[SLOTS];
 #define SLOT_MASK 4
 #define SLOT_TEXCOORDS 5
 #define SLOT_PAIRS 5
+// The varying location of the triangle's index (flat), after the texcoords'.
+#define TRIANGLE_LOCATION (SLOT_TEXCOORDS + SLOT_PAIRS)
 
 // Where a slot samples: texcoord = (dot(u.xyz, (uv, 1)), dot(v.xyz, (uv, 1))), KHR_texture_transform.
 struct TextureSlot {

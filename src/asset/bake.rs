@@ -21,6 +21,7 @@ use crate::gbuffer::GBuffer;
 use crate::gpu::graphics::{self, Attribute, GraphicsPipeline, PipelineDesc, Sampler, SamplerDesc, TextureSet};
 use crate::gpu::shaders::{self, Stage};
 use crate::gpu::{BindingKind, Buffer, Context, GlslLayout, GlslStruct, Image, Interface};
+use crate::visibility::{self, Grid, Mesh, SurfacePoint, Visibility};
 use crate::{Error, Result};
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
@@ -35,6 +36,9 @@ pub struct BakeOptions {
     /// Samples per pixel, one pass each.
     pub samples: u32,
     pub camera: CameraChoice,
+    /// Traces the asset's triangles from each pixel's surface for its visibility on this grid
+    /// (docs/formats.md#visibility); `None` stores none.
+    pub visibility: Option<Grid>,
 }
 
 /// The most samples per pixel: the per-pixel tallies are 16-bit.
@@ -86,12 +90,13 @@ const MATERIAL_DOUBLE_SIDED: u32 = 1;
 const MATERIAL_ALPHA_MASK: u32 = 2;
 
 /// The geometry pass's render targets, in bake.frag's output order, with their formats.
-const GEOMETRY_TARGETS: [vk::Format; 5] = [
+const GEOMETRY_TARGETS: [vk::Format; 6] = [
     vk::Format::R32G32B32A32_SFLOAT, // normal, w = covered
     vk::Format::R32G32B32A32_SFLOAT, // tangent, w = bitangent sign
     vk::Format::R32G32B32A32_SFLOAT, // view
     vk::Format::R32G32_UINT,         // object id, material + 1
     vk::Format::R32G32B32A32_SFLOAT, // COLOR_0
+    vk::Format::R32G32B32A32_UINT,   // the world position's bits (xyz), the triangle's index (w)
 ];
 
 /// The maps pass's render targets (bake_maps.frag): four that [`MAP_CHANNELS`] lays out, in half
@@ -181,6 +186,8 @@ pub enum Step {
     Meshes,
     /// Rasterizing, counted in passes (samples per pixel).
     Passes,
+    /// Tracing the visibility.
+    Visibility,
 }
 
 /// Bakes `asset` into a g-buffer. `progress(step, done, total)` follows the work.
@@ -235,10 +242,45 @@ pub fn bake(
     let mut accumulator = Accumulator::new(width, height, &kinds, &geometry);
     for (pass, offset) in jitter_pattern(options.samples).into_iter().enumerate() {
         let samples = rasterizer.pass(&geometry, &camera, offset)?;
-        accumulator.add(&samples);
+        accumulator.add(&samples, offset);
         progress(Step::Passes, pass as u32 + 1, options.samples);
     }
-    Ok(accumulator.finish(&camera, &geometry, &used))
+    let surfaces = std::mem::take(&mut accumulator.nearest);
+    let mut gbuffer = accumulator.finish(&camera, &geometry, &used);
+    if let Some(grid) = options.visibility {
+        progress(Step::Visibility, 0, 1);
+        gbuffer.visibility = Some(trace_visibility(grid, &geometry, &gbuffer, &surfaces));
+        progress(Step::Visibility, 1, 1);
+    }
+    Ok(gbuffer)
+}
+
+/// Each covered pixel's visibility, traced through the asset's triangles from the surface its
+/// sample nearest the pixel's centre hit. Rays leave from a point moved off the surface by a
+/// ten-thousandth of the scene's size along the triangle's normal, turned toward the eye.
+fn trace_visibility(grid: Grid, geometry: &Geometry, gbuffer: &GBuffer, surfaces: &[Option<[u32; 4]>]) -> Visibility {
+    let corners = |triangle: usize| {
+        let vertex = |k: usize| Vec3::from(geometry.vertices[3 * triangle + k].position);
+        [vertex(0), vertex(1), vertex(2)]
+    };
+    let mesh = Mesh::new((0..geometry.vertices.len() / 3).map(corners));
+    let points: Vec<Option<SurfacePoint>> = surfaces
+        .iter()
+        .enumerate()
+        .map(|(pixel, surface)| {
+            let [x, y, z, triangle] = (*surface)?;
+            let position = Vec3::new(f32::from_bits(x), f32::from_bits(y), f32::from_bits(z));
+            let view = Vec3::from(gbuffer.view[pixel]);
+            let facing = mesh.normal(triangle as usize);
+            let geometric = if facing.dot(view) < 0.0 { -facing } else { facing };
+            let shading = Vec3::from(gbuffer.normal[pixel]);
+            // A degenerate triangle has no normal: the shading normal stands in.
+            let geometric = if geometric == Vec3::ZERO { shading } else { geometric };
+            Some(SurfacePoint { position, geometric, shading })
+        })
+        .collect();
+    let offset = 1e-4 * 2.0 * geometry.bounds.1.max(f32::MIN_POSITIVE);
+    visibility::trace(grid, &points, &mesh, offset)
 }
 
 /// Sub-pixel offsets in [−0.5, 0.5)², stratified: a grid when `n` is a square, else a rank-1
@@ -308,6 +350,8 @@ struct Samples<'a> {
     view: &'a [[f32; 4]],
     ids: &'a [[u32; 2]],
     color: &'a [[f32; 4]],
+    /// The world position's bits and the triangle's index.
+    surface: &'a [[u32; 4]],
     /// The maps pass's targets, when it ran: the four of values, and each sample's material.
     maps: Vec<&'a [[f16; 4]]>,
     map_material: &'a [u32],
@@ -608,6 +652,7 @@ impl Rasterizer {
             view: bytemuck::cast_slice(next(16)),
             ids: bytemuck::cast_slice(next(8)),
             color: bytemuck::cast_slice(next(16)),
+            surface: bytemuck::cast_slice(next(16)),
             maps: (0..self.maps_pipeline.as_ref().map_or(0, |_| 4)).map(|_| bytemuck::cast_slice(next(8))).collect(),
             map_material: match self.maps_pipeline {
                 Some(_) => bytemuck::cast_slice(next(4)),
@@ -640,6 +685,10 @@ struct Accumulator {
     kind_hits: Vec<(MapKind, Vec<u16>)>,
     /// Per map channel of those kinds ([`MAP_CHANNELS`] index): the sum of its values.
     map_sums: Vec<(usize, Vec<f32>)>,
+    /// Per pixel: the surface (position bits, triangle) of its hit nearest the centre so far,
+    /// and that hit's squared distance from the centre.
+    nearest: Vec<Option<[u32; 4]>>,
+    nearest_distance: Vec<f32>,
 }
 
 impl Accumulator {
@@ -664,16 +713,24 @@ impl Accumulator {
                 .filter(|&c| present.contains(&MAP_CHANNELS[c].kind))
                 .map(|c| (c, vec![0.0; pixels]))
                 .collect(),
+            nearest: vec![None; pixels],
+            nearest_distance: vec![f32::INFINITY; pixels],
         }
     }
 
-    fn add(&mut self, s: &Samples) {
+    /// Adds a pass's samples, taken `offset` pixels from the centres.
+    fn add(&mut self, s: &Samples, offset: (f32, f32)) {
         self.samples += 1;
+        let distance = offset.0 * offset.0 + offset.1 * offset.1;
         for p in 0..self.hits.len() {
             if s.normal[p][3] < 0.5 {
                 continue;
             }
             self.hits[p] += 1;
+            if distance < self.nearest_distance[p] {
+                self.nearest_distance[p] = distance;
+                self.nearest[p] = Some(s.surface[p]);
+            }
             self.normal[p] += Vec3::from_slice(&s.normal[p][..3]);
             self.tangent[p] += Vec3::from_slice(&s.tangent[p][..3]);
             self.handedness[p] += if s.tangent[p][3] < 0.0 { -1 } else { 1 };
@@ -787,6 +844,7 @@ impl Accumulator {
             maps,
             object_names,
             mask_names,
+            visibility: None,
             has_view: true,
             has_tangent: true,
         }

@@ -5,6 +5,7 @@ use crate::asset::bake::{bake, BakeOptions, Step, MAX_SAMPLES};
 use crate::asset::camera::{CameraChoice, DEFAULT_FOV, DEFAULT_PITCH, DEFAULT_YAW};
 use crate::asset::Asset;
 use crate::gpu::ContextOptions;
+use crate::visibility::{self, Grid};
 use crate::{Error, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -39,12 +40,29 @@ pub struct BakeArgs {
     /// Samples per pixel for antialiased coverage, normals, masks and maps (1 to 1024).
     #[arg(long, default_value_t = 16)]
     pub samples: u32,
+    /// Each pixel's visibility, traced through the asset's triangles: the side of its grid of
+    /// directions (8, 16, 32 or 64; 32 stores 1024 directions, 128 bytes a pixel), or off.
+    #[arg(long, value_name = "SIDE|off", default_value = "32", value_parser = parse_visibility)]
+    pub visibility: Visibility,
     /// Vulkan device to use: part of its name (lavapipe is "llvmpipe").
     #[arg(long, value_name = "NAME")]
     pub device: Option<String>,
     /// No progress bar or summary.
     #[arg(long, short)]
     pub quiet: bool,
+}
+
+/// `--visibility`: a grid, or none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Visibility(pub Option<Grid>);
+
+fn parse_visibility(text: &str) -> std::result::Result<Visibility, String> {
+    if text == "off" {
+        return Ok(Visibility(None));
+    }
+    let side =
+        text.parse::<u32>().map_err(|_| format!("'{text}' is not a grid side ({}) or off", visibility::side_list()))?;
+    Grid::new(side).map(|grid| Visibility(Some(grid)))
 }
 
 /// The flags' values, before anything is read.
@@ -79,7 +97,13 @@ pub fn run(args: BakeArgs) -> Result<()> {
     if !unsupported.is_empty() {
         crate::warn(format!("{}: ignoring unsupported extensions: {}", args.model.display(), unsupported.join(", ")));
     }
-    let options = BakeOptions { width: args.size[0], height: args.size[1], samples: args.samples, camera };
+    let options = BakeOptions {
+        width: args.size[0],
+        height: args.size[1],
+        samples: args.samples,
+        camera,
+        visibility: args.visibility.0,
+    };
 
     let ctx = crate::gpu::Context::new(&ContextOptions { graphics: true, ..ContextOptions::from_env(args.device) })?;
     let counter = ctx.validation_counter();
@@ -94,6 +118,7 @@ pub fn run(args: BakeArgs) -> Result<()> {
                 let (label, unit) = match step {
                     Step::Meshes => ("reading meshes", "primitives"),
                     Step::Passes => ("baking", "passes"),
+                    Step::Visibility => ("tracing visibility", "steps"),
                 };
                 current = Some((step, Progress::counting(total as u64, label, unit, args.quiet)));
             }

@@ -97,6 +97,10 @@ pub struct GBufferArgs {
     /// --gbuffer-channel normal=N_world. Repeatable; mask adds one each time.
     #[arg(long = "gbuffer-channel", value_name = "ROLE=NAME")]
     pub channels: Vec<String>,
+    /// Relight as if nothing stood between any surface and the sky, leaving out the g-buffer's
+    /// visibility (its shadows and occlusion), for comparison.
+    #[arg(long)]
+    pub no_visibility: bool,
 }
 
 fn parse_point(text: &str) -> std::result::Result<glam::Vec3, String> {
@@ -119,7 +123,12 @@ impl GBufferArgs {
             camera_position: self.camera_position,
             channels,
         };
-        Ok(GBufferSpec { file: self.gbuffer.clone(), source, ..GBufferSpec::default() })
+        Ok(GBufferSpec {
+            file: self.gbuffer.clone(),
+            source,
+            ignore_visibility: self.no_visibility,
+            ..GBufferSpec::default()
+        })
     }
 }
 

@@ -16,6 +16,10 @@ pub struct GpuGBuffer {
     pub surface: Image,
     /// Each pixel's object id (R32_UINT), for the preview's and the display filter's edges.
     pub object_ids: Image,
+    /// The visibility words (RGBA32_UINT, `relight.comp`'s `visibility`: [`upload_visibility`]),
+    /// and the grid's side; a 1×1 placeholder and side 0 without visibility.
+    pub visibility: Image,
+    pub visibility_side: u32,
     ids: Vec<u32>,
     /// The masks and maps by full channel name (`mask.stripes`, `map.baseColor.R`).
     channels: BTreeMap<String, Vec<f32>>,
@@ -47,6 +51,7 @@ impl GpuGBuffer {
         surface.upload(ctx, bytemuck::cast_slice(&surface_data))?;
         let object_ids = Image::new(ctx, vk::Format::R32_UINT, width, height, 1, false)?;
         object_ids.upload(ctx, bytemuck::cast_slice(&gbuffer.object_id))?;
+        let (visibility, visibility_side) = upload_visibility(ctx, gbuffer)?;
         let masks = gbuffer.masks.iter().map(|(name, values)| (format!("{MASK_PREFIX}{name}"), values.clone()));
         let maps = gbuffer.maps.iter().map(|(name, values)| (format!("{MAP_PREFIX}{name}"), values.clone()));
         Ok(GpuGBuffer {
@@ -54,6 +59,8 @@ impl GpuGBuffer {
             height,
             surface,
             object_ids,
+            visibility,
+            visibility_side,
             ids: gbuffer.object_id.clone(),
             channels: masks.chain(maps).collect(),
             channel_layers: None,
@@ -100,4 +107,29 @@ impl GpuGBuffer {
         self.stack_index(ctx, packed)?;
         Ok((self.stack_index.as_ref().expect("just made"), &self.channel_layers.as_ref().expect("just made").1))
     }
+}
+
+/// Texels a row of the visibility image (`VISIBILITY_ROW` in relight.comp).
+pub const VISIBILITY_ROW: u32 = 4096;
+
+/// The g-buffer's visibility as relight.comp reads it: every pixel's words in turn, row-major,
+/// four a texel (a pixel's last texel padded with zeros), [`VISIBILITY_ROW`] texels a row, with
+/// the grid's side; a 1×1 placeholder and side 0 without.
+fn upload_visibility(ctx: &Context, gbuffer: &GBuffer) -> Result<(Image, u32)> {
+    let Some(visibility) = &gbuffer.visibility else {
+        return Ok((Image::new(ctx, vk::Format::R32G32B32A32_UINT, 1, 1, 1, false)?, 0));
+    };
+    let words = visibility.grid.words();
+    let per_pixel = words.div_ceil(4);
+    let texels = gbuffer.pixel_count() * per_pixel;
+    let rows = texels.div_ceil(VISIBILITY_ROW as usize) as u32;
+    let image = Image::filled(ctx, vk::Format::R32G32B32A32_UINT, VISIBILITY_ROW, rows, |out: &mut [[u32; 4]]| {
+        out.fill([0; 4]);
+        for (pixel, bits) in visibility.words.chunks_exact(words).enumerate() {
+            for (k, chunk) in bits.chunks(4).enumerate() {
+                out[pixel * per_pixel + k][..chunk.len()].copy_from_slice(chunk);
+            }
+        }
+    })?;
+    Ok((image, visibility.grid.side()))
 }

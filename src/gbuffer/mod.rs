@@ -30,6 +30,7 @@ pub use source::{SourceOptions, Up};
 /// The built-in sphere's object ID and framing.
 pub use sphere::{SPHERE_FRAME_HALF_EXTENT, SPHERE_ID};
 
+use crate::visibility::Visibility;
 use std::collections::BTreeMap;
 
 /// Channel names of the file format.
@@ -46,6 +47,9 @@ pub const MAP_PREFIX: &str = "map.";
 pub const COLOR_MAP_CHANNELS: [&str; 3] = ["R", "G", "B"];
 /// An object's name is stored in the header attribute with this prefix followed by its ID.
 pub const OBJECT_NAME_PREFIX: &str = "objectName.";
+/// A visibility channel is this prefix followed by its word's index (`visibility.0` …): 32 bits
+/// of the pixel's [`crate::visibility::Visibility`] each, as uint (docs/formats.md#visibility).
+pub const VISIBILITY_PREFIX: &str = "visibility.";
 /// The full name behind a mask whose channel name had to be shortened or made safe is stored
 /// in the header attribute with this prefix followed by the mask's name.
 pub const MASK_NAME_PREFIX: &str = "maskName.";
@@ -87,6 +91,9 @@ pub struct GBuffer {
     /// The full names of masks whose channel names were shortened or made safe (a material's
     /// name as the asset gives it), by mask name, from the `maskName.<mask>` header attributes.
     pub mask_names: BTreeMap<String, String>,
+    /// Which world directions each pixel's surface point sees the environment along; `None`
+    /// where nothing was stored, and every direction above the horizon is seen.
+    pub visibility: Option<Visibility>,
     /// Whether the file carried `V.*`.
     pub has_view: bool,
     /// Whether the file carried `T.*`.

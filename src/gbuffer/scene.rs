@@ -82,6 +82,27 @@ pub(crate) fn trace(origin: Vec3, direction: Vec3) -> Option<Hit> {
     nearest(nearest(ball, neck), foot)
 }
 
+/// The shader ball's own surfaces, as an occluder for its visibility.
+pub(crate) struct Occluders;
+
+impl crate::visibility::Occluder for Occluders {
+    fn occluded(&self, origin: Vec3, direction: Vec3) -> bool {
+        hit_ball(origin, direction).is_some()
+            || (hits_sphere(PEDESTAL_BOUNDS, origin, direction)
+                && (hit_cylinder(&NECK, origin, direction).is_some()
+                    || hit_cylinder(&FOOT, origin, direction).is_some()))
+    }
+
+    /// A point on the ball sees the ball behind its own horizon (it is convex), so only the
+    /// pedestal can stand in its way, and only where the pedestal rises above that horizon.
+    fn may_block(&self, point: &crate::visibility::SurfacePoint) -> bool {
+        let on_ball = (point.position.length() - BALL_RADIUS).abs() < 1e-3
+            && point.geometric.dot(point.position.normalize()) > 0.999;
+        let (centre, radius) = PEDESTAL_BOUNDS;
+        !on_ball || (centre - point.position).dot(point.geometric) > -radius
+    }
+}
+
 fn nearest(a: Option<Hit>, b: Option<Hit>) -> Option<Hit> {
     match (a, b) {
         (Some(a), Some(b)) => Some(if b.distance < a.distance { b } else { a }),

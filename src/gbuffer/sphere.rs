@@ -49,6 +49,7 @@ impl GBuffer {
             maps: BTreeMap::new(),
             object_names: BTreeMap::from([(SPHERE_ID, SPHERE_NAME.to_string())]),
             mask_names: BTreeMap::new(),
+            visibility: None,
             has_view: true,
             has_tangent: true,
         };

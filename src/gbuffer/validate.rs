@@ -12,8 +12,9 @@ use super::frame::{orthogonalize, stable_tangent};
 use super::source::raw::Samples;
 use super::{
     GBuffer, COLOR_MAP_CHANNELS, COVERAGE_CHANNEL, DEFAULT_VIEW, MAP_PREFIX, MASK_PREFIX, NORMAL_CHANNELS,
-    OBJECT_ID_CHANNEL, OBJECT_NAME_PREFIX, PLACEHOLDER_NORMAL, TANGENT_CHANNELS, VIEW_CHANNELS,
+    OBJECT_ID_CHANNEL, OBJECT_NAME_PREFIX, PLACEHOLDER_NORMAL, TANGENT_CHANNELS, VIEW_CHANNELS, VISIBILITY_PREFIX,
 };
+use crate::visibility::{self, Grid, Visibility};
 use crate::{Error, Result};
 
 /// A decoded EXR part, before any of its contents are checked.
@@ -108,6 +109,7 @@ impl Checker<'_> {
             maps,
             object_names,
             mask_names: raw.mask_names,
+            visibility: self.visibility(&raw.channels)?,
             has_view: raw_view.is_some(),
             has_tangent: raw_tangent.is_some(),
         };
@@ -433,6 +435,50 @@ impl Checker<'_> {
         Ok(found)
     }
 
+    /// The `visibility.<word>` channels: none, or uint words 0 to K − 1 for a grid of K words a
+    /// pixel (docs/formats.md#visibility).
+    fn visibility(&self, channels: &BTreeMap<String, Samples>) -> Result<Option<Visibility>> {
+        let mut words: BTreeMap<usize, &[u32]> = BTreeMap::new();
+        for (channel, samples) in channels {
+            let Some(index) = channel.strip_prefix(VISIBILITY_PREFIX) else {
+                continue;
+            };
+            let index = index.parse::<usize>().ok().filter(|i| i.to_string() == index).ok_or_else(|| {
+                self.error(format!(
+                    "channel {channel}: a visibility channel is named by its word's index, as {VISIBILITY_PREFIX}0"
+                ))
+            })?;
+            let Samples::U32(values) = samples else {
+                return Err(self.error(format!(
+                    "channel {channel} is not uint: visibility words hold 32 bits, which half and float samples cannot"
+                )));
+            };
+            words.insert(index, values);
+        }
+        if words.is_empty() {
+            return Ok(None);
+        }
+        let count = words.len();
+        let grid = Grid::from_words(count).filter(|_| words.keys().copied().eq(0..count)).ok_or_else(|| {
+            let sides = visibility::SIDES.map(|side| Grid::new(side).expect("a listed side").words().to_string());
+            self.error(format!(
+                "visibility channels {VISIBILITY_PREFIX}0 to {VISIBILITY_PREFIX}K-1 with K = {} are needed \
+                     (grids {} cells a side); found {count} with indices {}",
+                sides.join(", "),
+                visibility::side_list(),
+                words.keys().map(usize::to_string).collect::<Vec<_>>().join(", ")
+            ))
+        })?;
+        let pixels = words[&0].len();
+        let mut bits = vec![0u32; pixels * count];
+        for (word, values) in words.values().enumerate() {
+            for (pixel, &value) in values.iter().enumerate() {
+                bits[pixel * count + word] = value;
+            }
+        }
+        Ok(Some(Visibility { grid, words: bits }))
+    }
+
     /// Object names from `objectName.<ID>` text attributes; malformed ones are skipped.
     fn object_names(&mut self, attributes: &[(String, Option<String>)]) -> BTreeMap<u32, String> {
         let mut names = BTreeMap::new();
@@ -509,6 +555,7 @@ fn is_gbuffer_channel(name: &str) -> bool {
         || name == OBJECT_ID_CHANNEL
         || name.starts_with(MASK_PREFIX)
         || name.starts_with(MAP_PREFIX)
+        || name.starts_with(VISIBILITY_PREFIX)
 }
 
 #[cfg(test)]

@@ -10,14 +10,14 @@ use half::f16;
 
 use super::{
     GBuffer, COVERAGE_CHANNEL, MAP_PREFIX, MASK_NAME_PREFIX, MASK_PREFIX, NORMAL_CHANNELS, OBJECT_ID_CHANNEL,
-    OBJECT_NAME_PREFIX, TANGENT_CHANNELS, VIEW_CHANNELS,
+    OBJECT_NAME_PREFIX, TANGENT_CHANNELS, VIEW_CHANNELS, VISIBILITY_PREFIX,
 };
 use crate::{Error, Result};
 
 impl GBuffer {
     /// Writes the g-buffer as a single-part, ZIP-compressed EXR: `N.*` always, `V.*` if
-    /// `has_view`, `T.*` if `has_tangent` (all float), `A`, masks and maps as half, `objectId` as uint,
-    /// and object names as `objectName.<ID>` attributes.
+    /// `has_view`, `T.*` if `has_tangent` (all float), `A`, masks and maps as half, `objectId` and
+    /// the `visibility.<word>` channels as uint, and object names as `objectName.<ID>` attributes.
     ///
     /// The file appears atomically: it is written to a temporary file in the same folder, then
     /// renamed over `path`, so a reader never sees half a file.
@@ -43,6 +43,9 @@ impl GBuffer {
             ("object_id", self.object_id.len()),
         ];
         lengths.extend(self.masks.iter().chain(&self.maps).map(|(name, values)| (name.as_str(), values.len())));
+        if let Some(visibility) = &self.visibility {
+            lengths.push(("visibility", visibility.words.len() / visibility.grid.words()));
+        }
         if pixels == 0 {
             return Err(Error::io(path, "cannot write an empty g-buffer"));
         }
@@ -74,6 +77,13 @@ impl GBuffer {
         }
         for (name, map) in &self.maps {
             channels.push(half_channel(&format!("{MAP_PREFIX}{name}"), map));
+        }
+        if let Some(visibility) = &self.visibility {
+            let words = visibility.grid.words();
+            for word in 0..words {
+                let samples = visibility.words.iter().skip(word).step_by(words).copied().collect();
+                channels.push(AnyChannel::new(text(&format!("{VISIBILITY_PREFIX}{word}")), FlatSamples::U32(samples)));
+            }
         }
 
         let mut attributes = LayerAttributes { software_name: Some(text("lookdev")), ..LayerAttributes::default() };

@@ -31,6 +31,7 @@ pub fn sphere(size: u32) -> GBuffer {
         maps: BTreeMap::new(),
         object_names: BTreeMap::from([(1, "sphere".to_string())]),
         mask_names: BTreeMap::new(),
+        visibility: None,
         has_view: false,
         has_tangent: false,
     };

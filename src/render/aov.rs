@@ -7,7 +7,8 @@
 //! - Material: `albedo` and each resolved parameter, as `param_<name>` (`param_base_color`,
 //!   `param_roughness`, …; named without the prefix where no light AOV has the name).
 //! - Layers: `layers`, each layer's share of the blend, for every layer of every stack.
-//! - Geometry: `N`, `V` and `objectId`, as the g-buffer has them.
+//! - Geometry: `N`, `V` and `objectId`, as the g-buffer has them, and `occlusion`, the
+//!   cosine-weighted share of each pixel's hemisphere its stored visibility sees (1 without).
 //! - Error: `variance`, of each pixel's mean luminance.
 //! - Inputs: `masks` and `maps`, the g-buffer's masks and maps as read, as `mask_<name>` and
 //!   `map_<name>`.
@@ -32,6 +33,7 @@ pub enum Aov {
     Normal,
     View,
     ObjectId,
+    Occlusion,
     Variance,
     /// Every g-buffer mask, as `mask_<name>.Y`.
     Masks,
@@ -43,7 +45,7 @@ pub enum Aov {
 const GROUPS: [(&str, &str); 6] = [
     ("light", "diffuse, specular, clearcoat, sheen and emission"),
     ("material", "albedo and every parameter"),
-    ("geometry", "N, V and objectId"),
+    ("geometry", "N, V, objectId and occlusion"),
     ("error", "variance"),
     ("inputs", "masks and maps"),
     ("all", "every AOV"),
@@ -56,7 +58,16 @@ impl Aov {
         all.push(Aov::Emission);
         all.push(Aov::Albedo);
         all.extend(Param::ALL.into_iter().filter(|p| *p != Param::Emission).map(Aov::Param));
-        all.extend([Aov::Layers, Aov::Normal, Aov::View, Aov::ObjectId, Aov::Variance, Aov::Masks, Aov::Maps]);
+        all.extend([
+            Aov::Layers,
+            Aov::Normal,
+            Aov::View,
+            Aov::ObjectId,
+            Aov::Occlusion,
+            Aov::Variance,
+            Aov::Masks,
+            Aov::Maps,
+        ]);
         all
     }
 
@@ -71,6 +82,7 @@ impl Aov {
             Aov::Normal => "N".into(),
             Aov::View => "V".into(),
             Aov::ObjectId => "objectId".into(),
+            Aov::Occlusion => "occlusion".into(),
             Aov::Variance => "variance".into(),
             Aov::Masks => "masks".into(),
             Aov::Maps => "maps".into(),
@@ -85,7 +97,7 @@ impl Aov {
         let group = match name {
             "light" => Some(all.iter().copied().filter(|a| matches!(a, Aov::Lobe(_) | Aov::Emission)).collect()),
             "material" => Some(all.iter().copied().filter(|a| matches!(a, Aov::Albedo | Aov::Param(_))).collect()),
-            "geometry" => Some(vec![Aov::Normal, Aov::View, Aov::ObjectId]),
+            "geometry" => Some(vec![Aov::Normal, Aov::View, Aov::ObjectId, Aov::Occlusion]),
             "error" => Some(vec![Aov::Variance]),
             "inputs" => Some(vec![Aov::Masks, Aov::Maps]),
             "all" => Some(all.clone()),
@@ -225,6 +237,7 @@ pub fn layers(aovs: &[Aov], sources: &Sources) -> Result<Vec<Layer>> {
             Aov::Normal => out.push(Layer::color(aov.name(), g.normal.iter().copied())),
             Aov::View => out.push(Layer::color(aov.name(), g.view.iter().copied())),
             Aov::ObjectId => out.push(Layer::scalar(aov.name(), g.object_id.iter().map(|&id| id as f32).collect())),
+            Aov::Occlusion => out.push(Layer::scalar(aov.name(), crate::visibility::occlusion(g))),
             Aov::Variance => out.push(Layer::scalar(aov.name(), sources.renderer.read_variance(coverage)?)),
             Aov::Masks => {
                 out.extend(g.masks.iter().map(|(name, values)| Layer::scalar(mask_layer(name), values.clone())))

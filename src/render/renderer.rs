@@ -85,6 +85,8 @@ pub struct Renderer {
     sampling: Sampling,
     /// The lobes the relight kernel is specialised for: those of the stacks last set.
     lobes: LobesPresent,
+    /// Whether the relight kernel reads the g-buffer's visibility ([`Renderer::set_visibility`]).
+    visibility: bool,
     /// Pixel samples a second of its last dispatch that [`super::progressive::accumulate`]
     /// timed, set-up included: what sizes the next accumulation's first dispatch.
     pace: Option<f64>,
@@ -121,7 +123,7 @@ impl Renderer {
         kernels: KernelSource,
     ) -> Result<Renderer> {
         let (width, height) = (gbuffer.width, gbuffer.height);
-        let Specialization { model, accumulate, product, lobes, maps } = kernels.specialization();
+        let Specialization { model, accumulate, product, lobes, maps, visibility } = kernels.specialization();
         let gpu_gbuffer = GpuGBuffer::upload(ctx, gbuffer)?;
         let targets = Targets::new(ctx, width, height, accumulate)?;
         let gpu_environment = upload_environment(ctx, environment, sampling)?;
@@ -164,12 +166,14 @@ impl Renderer {
             denoise: None,
             sampling,
             lobes,
+            visibility: true,
             pace: None,
             finalized_rows: RefCell::new(vec![false; height as usize]),
             display_settings: Cell::new((0.0, Tonemap::Linear)),
         };
-        // Kernels compiled for another estimator's sampler are replaced, not used.
-        if product != sampling.product_kernel() {
+        // Kernels compiled for another estimator's sampler, or another visibility grid, are
+        // replaced, not used.
+        if product != sampling.product_kernel() || visibility != renderer.gbuffer.visibility_side {
             renderer.respecialize(model, accumulate)?;
         }
         Ok(renderer)
@@ -226,7 +230,14 @@ impl Renderer {
     fn respecialize(&mut self, model: Model, accumulate: Accumulate) -> Result<()> {
         self.relight = RelightPass::new(
             &self.ctx,
-            RelightPass::pipeline(&self.ctx, &model, accumulate, self.sampling.product_kernel(), self.lobes)?,
+            RelightPass::pipeline(
+                &self.ctx,
+                &model,
+                accumulate,
+                self.sampling.product_kernel(),
+                self.lobes,
+                self.visibility_side(),
+            )?,
             &model,
             accumulate,
             &self.gbuffer,
@@ -236,6 +247,35 @@ impl Renderer {
         )?;
         self.restart();
         Ok(())
+    }
+
+    /// Relights with the g-buffer's visibility or as if every direction above the horizon were
+    /// seen (for comparison): a kernel specialised without it, whose images are those of a
+    /// g-buffer that has none, bit for bit. Accumulation restarts when this changes anything.
+    pub fn set_visibility(&mut self, on: bool) -> Result<()> {
+        if on == self.visibility {
+            return Ok(());
+        }
+        let before = self.visibility_side();
+        self.visibility = on;
+        if self.visibility_side() == before {
+            return Ok(());
+        }
+        self.respecialize(self.relight.shading.model, self.relight.accumulate)
+    }
+
+    /// Whether the g-buffer has visibility, whether or not it is used.
+    pub fn has_visibility(&self) -> bool {
+        self.gbuffer.visibility_side > 0
+    }
+
+    /// The side of the visibility grid the relight kernel reads: 0 when off or absent.
+    fn visibility_side(&self) -> u32 {
+        if self.visibility {
+            self.gbuffer.visibility_side
+        } else {
+            0
+        }
     }
 
     /// Samples every pixel has accumulated since the last change: the least of any row's
@@ -922,6 +962,8 @@ pub struct Specialization {
     pub lobes: LobesPresent,
     /// Whether the scene's stacks bind maps ([`PackedStacks::binds_maps`]), for the resolve.
     pub maps: bool,
+    /// The side of the g-buffer's visibility grid, 0 without visibility.
+    pub visibility: u32,
 }
 
 impl Default for Specialization {
@@ -933,6 +975,7 @@ impl Default for Specialization {
             product: Sampling::default().product_kernel(),
             lobes: LobesPresent::default(),
             maps: false,
+            visibility: 0,
         }
     }
 }
@@ -949,6 +992,7 @@ impl Specialization {
             product: settings.sampling.product_kernel(),
             lobes: scene.stacks.lobes(),
             maps: scene.stacks.binds_maps(),
+            visibility: scene.gbuffer.visibility.as_ref().map_or(0, |v| v.grid.side()),
         }
     }
 }
@@ -965,10 +1009,10 @@ impl Kernels {
     /// Compiles them, the relight kernel (by far the slowest) first. Pipeline creation is
     /// thread-safe, so this may run on any thread while the context is used on others.
     pub fn compile(ctx: &Context, specialization: Specialization) -> Result<Kernels> {
-        let Specialization { model, accumulate, product, lobes, maps } = specialization;
+        let Specialization { model, accumulate, product, lobes, maps, visibility } = specialization;
         Ok(Kernels {
             specialization,
-            relight: RelightPass::pipeline(ctx, &model, accumulate, product, lobes)?,
+            relight: RelightPass::pipeline(ctx, &model, accumulate, product, lobes, visibility)?,
             resolve: ResolvePass::pipeline(ctx, maps)?,
             finalize: FinalizePass::pipeline(ctx, false)?,
         })

@@ -68,7 +68,11 @@ impl Scene {
         prepare_look(&mut look, &spec.sets)?;
         let settings = Settings::resolve(&look, &spec.overrides)?;
         let environment = load_environment(settings.environment.as_ref(), &spec.env_options)?;
-        let ReadGBuffer { gbuffer, name: gbuffer_name, claims } = read_gbuffer(&spec.gbuffer, &mut look, spec.quiet)?;
+        let ReadGBuffer { mut gbuffer, name: gbuffer_name, claims } =
+            read_gbuffer(&spec.gbuffer, &mut look, spec.quiet)?;
+        if spec.gbuffer.ignore_visibility {
+            gbuffer.visibility = None;
+        }
         claims.into_iter().for_each(crate::warn);
         let covered = covered_object_ids(&gbuffer);
         let stacks = PackedStacks::pack(&look, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
@@ -114,6 +118,9 @@ pub struct GBufferSpec {
     /// `builtin_size` came from `--size`: a g-buffer file the look names is then an error, not
     /// a silent change of size.
     pub size_given: bool,
+    /// Leaves the g-buffer's visibility out (`--no-visibility`): every direction above the
+    /// horizon is seen, as in a g-buffer without it.
+    pub ignore_visibility: bool,
 }
 
 /// A look made ready to render with `sets`: with any, it gets a default stack if it has none,
@@ -195,7 +202,8 @@ pub fn read_gbuffer(spec: &GBufferSpec, look: &mut Look, quiet: bool) -> Result<
         }
         None => {
             let (width, height) = spec.builtin_size.unwrap_or((BUILTIN_SIZE, BUILTIN_SIZE));
-            (GBuffer::shaderball(width, height), PathBuf::from("built-in shader ball"))
+            let visibility = !spec.ignore_visibility;
+            (GBuffer::shaderball_with(width, height, visibility), PathBuf::from("built-in shader ball"))
         }
     };
     let claims = look.resolve_object_names(&gbuffer.object_names, &name)?;

@@ -135,6 +135,8 @@ pub struct Session {
     snapshot_compare: Option<SnapshotCompare>,
     /// Whether the display filter (denoise) is shown instead of the accumulation's own pixels.
     pub denoise: bool,
+    /// Whether the renderers use the g-buffer's visibility ([`Session::set_visibility`]).
+    pub visibility: bool,
     /// The sample count the display filter last ran at, `None` when it must run again (a
     /// change, a preview, other display settings).
     denoised_at: Option<u32>,
@@ -167,6 +169,7 @@ fn stacks_renderer(
         product: sampling.product_kernel(),
         lobes: packed.lobes(),
         maps: packed.binds_maps(),
+        visibility: gbuffer.visibility.as_ref().map_or(0, |v| v.grid.side()),
         ..Specialization::default()
     });
     let mut renderer = Renderer::with_kernels(ctx, gbuffer, environment, sampling, kernels)?;
@@ -224,6 +227,7 @@ impl Session {
             snapshots: Snapshots::default(),
             snapshot_compare: None,
             denoise: false,
+            visibility: true,
             denoised_at: None,
         })
     }
@@ -314,6 +318,31 @@ impl Session {
     /// B's display image, when comparing.
     pub fn compare_image(&self) -> Option<&Image> {
         self.compare.as_ref().map(|b| shown_image(&b.renderer, self.denoise))
+    }
+
+    /// Relights with the g-buffer's visibility (shadows and occlusion) or without it, for
+    /// comparison; both sides of an A/B split alike. Not part of the look: a saved image is
+    /// what is shown. Every pixel restarts.
+    pub fn set_visibility(&mut self, on: bool) -> Result<()> {
+        if on == self.visibility {
+            return Ok(());
+        }
+        self.visibility = on;
+        self.renderer.set_visibility(on)?;
+        if let Some(b) = &mut self.compare {
+            b.renderer.set_visibility(on)?;
+            b.progressive.restart();
+        }
+        self.progressive.restart();
+        self.changed_at = Instant::now();
+        self.first_pass_after_change = None;
+        self.denoised_at = None;
+        self.refresh_inspection()
+    }
+
+    /// Whether the g-buffer has visibility to switch.
+    pub fn has_visibility(&self) -> bool {
+        self.gbuffer.visibility.is_some()
     }
 
     /// Turns the display filter on or off. It changes only what is shown: never the samples,

@@ -92,6 +92,11 @@ impl<'a> Reference<'a> {
             let t = texel_of(self.env.width, self.env.height, direction_to_uv(d));
             (Vec3::from(self.env.texel(t.x, t.y)), pdf_env(t))
         };
+        // relight.comp's seen(): the g-buffer's bit for the direction, turned back into the world.
+        let seen = |d: Vec3| {
+            let world = Vec3::new(d.x * cos_r + d.z * sin_r, d.y, -d.x * sin_r + d.z * cos_r);
+            g.visibility.as_ref().is_none_or(|visibility| visibility.seen(i, world))
+        };
         let emission = Vec3::from(params.emission);
         if v.z <= 0.0 {
             return (0..spp).fold(sum, |sum, _| sum + emission);
@@ -102,7 +107,7 @@ impl<'a> Reference<'a> {
             let (d, t) = sample_env(u_env);
             let (le, pdf_env) = (Vec3::from(self.env.texel(t.x, t.y)), pdf_env(t));
             let l = env_frame.to_local(d);
-            if l.z > 0.0 && pdf_env > 0.0 {
+            if l.z > 0.0 && pdf_env > 0.0 && seen(d) {
                 let hv = make_half_vector(&lobes, l, v);
                 let f = disney_brdf(&lobes, &view_terms, l, &hv);
                 let pdf_brdf = brdf_pdf(&choice, &view_terms, l, &hv);
@@ -112,8 +117,8 @@ impl<'a> Reference<'a> {
             if l.z > 0.0 {
                 let hv = make_half_vector(&lobes, l, v);
                 let pdf_brdf = brdf_pdf(&choice, &view_terms, l, &hv);
-                if pdf_brdf > 0.0 {
-                    let d = env_frame.to_world(l).normalize();
+                let d = env_frame.to_world(l).normalize();
+                if pdf_brdf > 0.0 && seen(d) {
                     let (le, pdf_env) = texel(d);
                     let f = disney_brdf(&lobes, &view_terms, l, &hv);
                     radiance += f * (l.z * mis_weight_over_pdf(pdf_brdf, pdf_env)) * le;

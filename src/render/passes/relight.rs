@@ -22,9 +22,9 @@ pub const INTERFACE: Interface =
     Interface::compute(&shaders::RELIGHT, &[&SET, &environment::gpu::SET_LAYOUT], Some(RelightPush::GLSL));
 
 /// Set 0 of `relight.comp`: surface, resolved material, accumulation, background, energy
-/// table, lobe sums, squared luminances, the covered and restarted pixel lists, and the active
-/// counts. Set 1 is the environment's.
-pub const SET: [BindingKind; 10] = [
+/// table, lobe sums, squared luminances, the covered and restarted pixel lists, the active
+/// counts and the visibility. Set 1 is the environment's.
+pub const SET: [BindingKind; 11] = [
     BindingKind::StorageImage,
     BindingKind::StorageImage,
     BindingKind::StorageImage,
@@ -35,6 +35,7 @@ pub const SET: [BindingKind; 10] = [
     BindingKind::StorageImage,
     BindingKind::StorageImage,
     BindingKind::StorageBuffer,
+    BindingKind::StorageImage,
 ];
 
 /// Which pixels a relight dispatch's invocations stand for (`SOURCE_*` in relight.comp).
@@ -122,17 +123,19 @@ pub struct RelightPass {
 
 impl RelightPass {
     /// Compiles `relight.comp` specialised for `model` and `accumulate`, sampling the environment
-    /// by the product tables when `product` is set, with the code of the lobes in `lobes` only.
+    /// by the product tables when `product` is set, with the code of the lobes in `lobes` only,
+    /// and reading visibility on a grid of `visibility_side` cells a side (0: none).
     pub fn pipeline(
         ctx: &Context,
         model: &Model,
         accumulate: Accumulate,
         product: bool,
         lobes: LobesPresent,
+        visibility_side: u32,
     ) -> Result<ComputePipeline> {
         let mut constants = model.specialization().to_vec();
         constants.extend([accumulate.lobes as u32, accumulate.variance as u32, product as u32]);
-        constants.extend([lobes.diffuse as u32, lobes.clearcoat as u32]);
+        constants.extend([lobes.diffuse as u32, lobes.clearcoat as u32, visibility_side]);
         ComputePipeline::specialized(ctx, &shaders::RELIGHT, INTERFACE.sets, INTERFACE.push_size(), &constants)
     }
 
@@ -170,6 +173,7 @@ impl RelightPass {
                 Binding::Image(&lists.covered_image),
                 Binding::Image(&lists.restarted_image),
                 Binding::Buffer(&lists.active),
+                Binding::Image(&gbuffer.visibility),
             ],
         )?;
         let environment_set = pipeline.bind(1, &environment.bindings())?;
