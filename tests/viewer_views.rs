@@ -305,3 +305,24 @@ fn an_unknown_view_stops_the_script_with_a_suggestion() {
     assert!(text.contains("bad.script:3: unknown view 'roughnes'"), "{text}");
     assert!(text.contains("did you mean 'roughness'?") && !text.contains("panicked"), "{text}");
 }
+
+#[test]
+fn switching_the_visibility_off_shows_the_render_without_it_and_back() {
+    let Some(case) = Case::new() else { return };
+    case.write(
+        "visibility.script",
+        "visibility off\nwait-spp 4\nsave-image off.exr\nvisibility on\nwait-spp 4\nsave-image on.exr\n",
+    );
+    assert_success(&case.view(&["--script", "visibility.script", "--exit-after-spp", "4"]));
+    for (image, flags) in [("off", &["--no-visibility"][..]), ("on", &[][..])] {
+        let out = format!("{image}-render.exr");
+        let mut args = vec!["render", "--gbuffer", "g.exr", "--spp", "4", "--quiet", "--out", &out];
+        args.extend(flags);
+        assert_success(&case.command(&args).output().unwrap());
+        assert!(
+            case.exr_bits(&format!("{image}.exr")) == case.exr_bits(&out),
+            "{image}: the render's pixels, bit for bit"
+        );
+    }
+    assert!(case.exr_bits("off.exr") != case.exr_bits("on.exr"), "the shader ball's shadows change its image");
+}

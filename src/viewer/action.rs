@@ -83,6 +83,8 @@ pub enum Action {
     DeleteSnapshot(String),
     /// Shows the display filter (denoise) or not: what is shown only, never what is saved.
     Denoise(bool),
+    /// Relights with the g-buffer's visibility or without it, for comparison.
+    Visibility(bool),
     /// Steps this many environments through the library (←/→, a script's `env next|prev`): an
     /// undoable change of the look's environment, as `OpenEnvironment` makes.
     StepEnvironment(i32),

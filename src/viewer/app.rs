@@ -515,6 +515,18 @@ impl Running {
                 self.session.delete_snapshot(&name)?;
                 return Ok(Some(format!("deleted snapshot {name}")));
             }
+            Action::Visibility(on) => {
+                if !self.session.has_visibility() {
+                    return Err(Error::input("the g-buffer has no visibility to switch"));
+                }
+                self.session.set_visibility(on)?;
+                let state = if on {
+                    "on: shadows and occlusion"
+                } else {
+                    "off: every direction above the horizon sees the sky"
+                };
+                return Ok(Some(format!("visibility {state}")));
+            }
             Action::Denoise(on) => {
                 self.session.set_denoise(on);
                 let state = if on { "on: the view is denoised; saved images are not" } else { "off" };

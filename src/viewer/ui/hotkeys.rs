@@ -26,6 +26,7 @@ pub const HOTKEYS: &[Hotkey] = &[
     Hotkey { keys: "P", does: "Take a snapshot of the image and its look" },
     Hotkey { keys: "ArrowLeft / ArrowRight", does: "Previous / next environment in the library (an undoable edit)" },
     Hotkey { keys: "D", does: "Denoised display on or off (a display filter: never in saved images)" },
+    Hotkey { keys: "O", does: "Shadows (the g-buffer's visibility) on or off, for comparison" },
     Hotkey { keys: "?", does: "Show or hide this sheet" },
     Hotkey { keys: "Enter", does: "In a file dialog's name field: open or save that file" },
 ];

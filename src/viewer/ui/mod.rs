@@ -31,6 +31,10 @@ use std::time::{Duration, Instant};
 const DENOISE_HINT: &str = "Shows the accumulation through an edge-avoiding filter guided by the g-buffer's normals, \
     base colours and object ids. Only the view: saved images are never filtered.";
 
+/// What switching the visibility off does, where it is offered and marked.
+const VISIBILITY_HINT: &str = "Relights with the g-buffer's visibility (shadows and occlusion), or, off, as if every \
+    direction above each pixel's horizon saw the sky, for comparison. Not saved with the look.";
+
 /// How long a status message stays.
 const MESSAGE_TIME: Duration = Duration::from_secs(8);
 
@@ -217,6 +221,9 @@ impl Interface {
             if input.consume_key(Modifiers::NONE, Key::D) {
                 actions.push(Action::Denoise(!frame.session.denoise));
             }
+            if frame.session.has_visibility() && input.consume_key(Modifiers::NONE, Key::O) {
+                actions.push(Action::Visibility(!frame.session.visibility));
+            }
             // As in Unity's Look Dev: the arrows step through the environment library.
             if input.consume_key(Modifiers::NONE, Key::ArrowLeft) {
                 actions.push(Action::StepEnvironment(-1));
@@ -299,6 +306,15 @@ impl Interface {
                 if ui.add(denoise).on_hover_text(DENOISE_HINT).clicked() {
                     actions.push(Action::Denoise(!frame.session.denoise));
                 }
+                let visibility =
+                    egui::Button::selectable(frame.session.visibility, "Shadows (visibility)").shortcut_text("O");
+                let visibility = ui
+                    .add_enabled(frame.session.has_visibility(), visibility)
+                    .on_hover_text(VISIBILITY_HINT)
+                    .on_disabled_hover_text("The g-buffer has no visibility");
+                if visibility.clicked() {
+                    actions.push(Action::Visibility(!frame.session.visibility));
+                }
                 ui.separator();
                 views::menu(ui, frame.session, frame.views, actions);
             });
@@ -348,6 +364,11 @@ impl Interface {
                 ui.label(format!("preview {:.0} ms", preview.as_secs_f64() * 1e3)).on_hover_text(format!(
                     "Time from the last change to a whole frame at the new state, one sample per {block}×{block} block"
                 ));
+            }
+            if !session.visibility {
+                ui.separator();
+                ui.label(egui::RichText::new("no shadows · comparison").color(ui.visuals().warn_fg_color))
+                    .on_hover_text(VISIBILITY_HINT);
             }
             if session.denoise {
                 ui.separator();
