@@ -50,11 +50,15 @@ pub struct BenchArgs {
 
 const SIZES: [(u32, u32); 2] = [(512, 512), (1920, 1080)];
 
-/// The built-in scene at `width`×`height`, with the default look and environment: what every
-/// benchmark measures.
-pub fn builtin_scene(width: u32, height: u32) -> Result<Scene> {
+/// The built-in scene at `width`×`height`, with the default look and environment, and with its
+/// visibility or without: what every benchmark measures.
+pub fn builtin_scene(width: u32, height: u32, visibility: bool) -> Result<Scene> {
     Scene::load(&SceneSpec {
-        gbuffer: GBufferSpec { builtin_size: Some((width, height)), ..GBufferSpec::default() },
+        gbuffer: GBufferSpec {
+            builtin_size: Some((width, height)),
+            ignore_visibility: !visibility,
+            ..GBufferSpec::default()
+        },
         quiet: true,
         ..SceneSpec::default()
     })
@@ -87,11 +91,12 @@ pub fn run(args: BenchArgs) -> Result<()> {
         .collect();
     println!("accumulated beside the beauty: {}", if beside.is_empty() { "nothing".into() } else { beside.join(", ") });
     println!(
-        "{:>10} {:>9} {:>16} {:>16} {:>14} {:>12}",
-        "size", "coverage", "Msamples/s", "Msamples/s", "kernel/1spp", "wall"
+        "{:>10} {:>10} {:>9} {:>16} {:>16} {:>14} {:>12}",
+        "size", "visibility", "coverage", "Msamples/s", "Msamples/s", "kernel/1spp", "wall"
     );
     println!(
-        "{:>10} {:>9} {:>16} {:>16} {:>14} {:>12}",
+        "{:>10} {:>10} {:>9} {:>16} {:>16} {:>14} {:>12}",
+        "",
         "",
         "",
         "(all pixels)",
@@ -99,10 +104,12 @@ pub fn run(args: BenchArgs) -> Result<()> {
         "(GPU, median)",
         format!("({} spp)", args.spp)
     );
-    // Per size: covered samples per second over the wall time, and per kernel time at 1 spp.
+    // Per size: covered samples per second over the wall time, and per kernel time at 1 spp,
+    // with the scene's visibility and then without.
     let mut rates: Vec<(f64, Option<f64>)> = Vec::new();
-    for (width, height) in SIZES {
-        let scene = builtin_scene(width, height)?;
+    let mut without_visibility: Vec<(f64, Option<f64>)> = Vec::new();
+    for ((width, height), visibility) in SIZES.into_iter().flat_map(|size| [(size, true), (size, false)]) {
+        let scene = builtin_scene(width, height, visibility)?;
         let gbuffer = &scene.gbuffer;
         let coverage = gbuffer.coverage.iter().filter(|&&a| a > 0.0).count() as f64 / gbuffer.pixel_count() as f64;
         let mut renderer = Renderer::new(&ctx, gbuffer, &scene.environment)?;
@@ -128,8 +135,9 @@ pub fn run(args: BenchArgs) -> Result<()> {
         let samples = gbuffer.pixel_count() as f64 * args.spp as f64;
         let wall = stats.wall.as_secs_f64();
         println!(
-            "{:>10} {:>8.1}% {:>16.2} {:>16.2} {:>14} {:>10.3} s",
+            "{:>10} {:>10} {:>8.1}% {:>16.2} {:>16.2} {:>14} {:>10.3} s",
             format!("{width}x{height}"),
+            if visibility { "on" } else { "off" },
             coverage * 100.0,
             samples / wall / 1e6,
             samples * coverage / wall / 1e6,
@@ -137,7 +145,23 @@ pub fn run(args: BenchArgs) -> Result<()> {
             wall
         );
         let covered = gbuffer.pixel_count() as f64 * coverage;
-        rates.push((samples * coverage / wall, median.map(|t| covered / t)));
+        let rate = (samples * coverage / wall, median.map(|t| covered / t));
+        if visibility {
+            rates.push(rate);
+        } else {
+            without_visibility.push(rate);
+        }
+    }
+    for (((width, height), (wall, kernel)), (wall_off, kernel_off)) in SIZES.iter().zip(&rates).zip(&without_visibility)
+    {
+        let kernel = match (kernel, kernel_off) {
+            (Some(a), Some(b)) => format!(", {:.0}% by kernel time", 100.0 * a / b),
+            _ => String::new(),
+        };
+        println!(
+            "covered rate with visibility at {width}x{height}: {:.0}% of without by wall time{kernel}",
+            100.0 * wall / wall_off
+        );
     }
     // How far partly covered frames fall behind: the covered rate of the last size against
     // the first's, by wall time (batches as `render` makes them) and by kernel time at 1 spp.

@@ -41,7 +41,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     );
     println!("{:>10}  {:<34} {:>12} {:>12}", "size", "complete frame by", "median", "95th pct");
     for (width, height) in SIZES {
-        let scene = super::bench::builtin_scene(width, height)?;
+        let scene = super::bench::builtin_scene(width, height, true)?;
         let mut renderer = Renderer::new(&ctx, &scene.gbuffer, &scene.environment)?;
         renderer.set_stacks(&scene.stacks)?;
         let (exposure, tonemap) = (scene.settings.exposure, scene.settings.tonemap);
@@ -99,7 +99,7 @@ fn run_local_edit(args: &BenchArgs) -> Result<()> {
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
     let (width, height) = LOCAL_SIZE;
-    let scene = super::bench::builtin_scene(width, height)?;
+    let scene = super::bench::builtin_scene(width, height, true)?;
     println!("device: {}", ctx.info().name);
     println!("scene: built-in shader ball {width}x{height}, built-in default look, default environment");
     println!("time from an edit of one object's stack until it is back at {LOCAL_SPP} spp, over {} edits:", args.edits);
