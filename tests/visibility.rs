@@ -353,3 +353,45 @@ fn fibonacci(n: usize) -> impl Iterator<Item = Vec3> {
         Vec3::new(r * (golden * i as f32).cos(), y, r * (golden * i as f32).sin())
     })
 }
+
+#[test]
+fn visibility_too_large_for_the_device_is_a_named_error() {
+    use lookdev::render::scene::{GBufferSpec, Scene, SceneSpec};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("wide.exr");
+    let device = |max: u32| lookdev::gpu::DeviceInfo {
+        name: "a small device".into(),
+        device_type: ash::vk::PhysicalDeviceType::CPU,
+        timestamp_period_ns: None,
+        max_image_dimension_2d: max,
+        max_color_attachments: 8,
+        max_image_array_layers: 256,
+        subgroup_size: 8,
+    };
+    for (side, fits) in [(16, true), (64, false)] {
+        let mut g = GBuffer::sphere(256, 256);
+        let grid = Grid::new(side).unwrap();
+        g.visibility = Some(visibility::Visibility { grid, words: vec![u32::MAX; g.pixel_count() * grid.words()] });
+        g.write(&path).unwrap();
+        let spec = SceneSpec {
+            gbuffer: GBufferSpec { file: Some(path.clone()), ..GBufferSpec::default() },
+            quiet: true,
+            ..SceneSpec::default()
+        };
+        let scene = Scene::load(&spec).unwrap();
+        // 256² pixels of 32 texels at 4096 a row: 512 rows, over a 256-texel limit.
+        match scene.check_device(&device(256)) {
+            Ok(()) => assert!(fits, "side {side} passed"),
+            Err(error) => {
+                assert!(!fits, "side {side}: {error}");
+                assert_eq!(error.exit_code(), 2);
+                let message = error.to_string();
+                assert!(message.starts_with(&format!("{}: ", path.display())), "{message}");
+                assert!(
+                    message.contains("4096 directions a pixel at 256x256") && message.contains("--visibility"),
+                    "{message}"
+                );
+            }
+        }
+    }
+}

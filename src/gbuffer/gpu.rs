@@ -112,6 +112,11 @@ impl GpuGBuffer {
 /// Texels a row of the visibility image (`VISIBILITY_ROW` in relight.comp).
 pub const VISIBILITY_ROW: u32 = 4096;
 
+/// The rows the visibility image of `pixels` pixels on `grid` takes ([`upload_visibility`]).
+pub fn visibility_rows(pixels: usize, grid: crate::visibility::Grid) -> u64 {
+    (pixels as u64 * grid.words().div_ceil(4) as u64).div_ceil(VISIBILITY_ROW as u64)
+}
+
 /// The g-buffer's visibility as relight.comp reads it: every pixel's words in turn, row-major,
 /// four a texel (a pixel's last texel padded with zeros), [`VISIBILITY_ROW`] texels a row, with
 /// the grid's side; a 1×1 placeholder and side 0 without.
@@ -121,8 +126,7 @@ fn upload_visibility(ctx: &Context, gbuffer: &GBuffer) -> Result<(Image, u32)> {
     };
     let words = visibility.grid.words();
     let per_pixel = words.div_ceil(4);
-    let texels = gbuffer.pixel_count() * per_pixel;
-    let rows = texels.div_ceil(VISIBILITY_ROW as usize) as u32;
+    let rows = visibility_rows(gbuffer.pixel_count(), visibility.grid) as u32;
     let image = Image::filled(ctx, vk::Format::R32G32B32A32_UINT, VISIBILITY_ROW, rows, |out: &mut [[u32; 4]]| {
         out.fill([0; 4]);
         for (pixel, bits) in visibility.words.chunks_exact(words).enumerate() {

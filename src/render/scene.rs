@@ -94,6 +94,20 @@ impl Scene {
                 format!("the g-buffer is {w}x{h}, larger than {}'s {max}-pixel image limit", info.name),
             ));
         }
+        if let Some(visibility) = &self.gbuffer.visibility {
+            let rows = crate::gbuffer::gpu::visibility_rows(self.gbuffer.pixel_count(), visibility.grid);
+            if rows > max as u64 {
+                return Err(crate::Error::input_file(
+                    &self.gbuffer_name,
+                    format!(
+                        "its visibility ({} directions a pixel at {w}x{h}) needs an image {rows} rows tall, more than \
+                         {}'s {max}: bake it with a smaller --visibility, or render with --no-visibility",
+                        visibility.grid.cells(),
+                        info.name
+                    ),
+                ));
+            }
+        }
         if self.stacks.channels.len() as u32 > info.max_image_array_layers {
             return Err(crate::Error::input(format!(
                 "the look uses {} mask and map channels, more than {}'s {} image layers",
