@@ -153,9 +153,15 @@ fn ground_gbuffer(size: u32, grid: Grid) -> GBuffer {
     g
 }
 
-/// Lambert diffuse with no specular at all (the exact dielectric Fresnel of specular 0 is 0):
-/// under a uniform white sky, a white surface's radiance is its occlusion.
-fn lambert_white() -> (Model, lookdev::material::Look) {
+/// A renderer of `g` in Lambert diffuse with no specular at all (the exact dielectric Fresnel of
+/// specular 0 is 0), white, with the background off and the environment turned `rotation`
+/// degrees: under a white sky, a pixel's radiance is its occlusion.
+fn lambert_white(
+    ctx: &lookdev::gpu::Context,
+    g: &GBuffer,
+    env: &Environment,
+    rotation: f32,
+) -> lookdev::render::Renderer {
     let model = Model { diffuse: Diffuse::Lambert, fresnel: Fresnel::Dielectric, ..Model::default() };
     let look = common::scenes::look(
         r#"
@@ -167,7 +173,12 @@ specular = 0.0
 roughness = 1.0
 "#,
     );
-    (model, look)
+    let ids = lookdev::render::scene::covered_object_ids(g);
+    let stacks = lookdev::material::stack::PackedStacks::pack(&look, ids, g, std::path::Path::new("ground")).unwrap();
+    let mut renderer = lookdev::render::Renderer::with_model(ctx, g, env, &model).unwrap();
+    renderer.set_stacks(&stacks).unwrap();
+    renderer.set_lighting(Lighting { background: false, rotation_degrees: rotation, ..Lighting::default() });
+    renderer
 }
 
 #[test]
@@ -176,13 +187,8 @@ fn under_a_white_sky_the_ground_renders_its_stored_occlusion() {
     let size = 48;
     let grid = Grid::new(32).unwrap();
     let g = ground_gbuffer(size, grid);
-    let (model, look) = lambert_white();
     let env = Environment::uniform([1.0; 3], 64, 32);
-    let ids = lookdev::render::scene::covered_object_ids(&g);
-    let stacks = lookdev::material::stack::PackedStacks::pack(&look, ids, &g, std::path::Path::new("ground")).unwrap();
-    let mut renderer = lookdev::render::Renderer::with_model(&ctx, &g, &env, &model).unwrap();
-    renderer.set_stacks(&stacks).unwrap();
-    renderer.set_lighting(Lighting { background: false, ..Lighting::default() });
+    let mut renderer = lambert_white(&ctx, &g, &env, 0.0);
     let spp = 512;
     renderer.render_samples(spp).unwrap();
     let radiance = renderer.read_radiance().unwrap();
@@ -214,9 +220,7 @@ fn under_a_white_sky_the_ground_renders_its_stored_occlusion() {
     // Without the visibility the same ground is lit by the whole sky.
     let mut open = g.clone();
     open.visibility = None;
-    let mut renderer = lookdev::render::Renderer::with_model(&ctx, &open, &env, &model).unwrap();
-    renderer.set_stacks(&stacks).unwrap();
-    renderer.set_lighting(Lighting { background: false, ..Lighting::default() });
+    let mut renderer = lambert_white(&ctx, &open, &env, 0.0);
     renderer.render_samples(64).unwrap();
     let unoccluded = mean(&mut renderer.read_radiance().unwrap().iter().map(|p| p[1]));
     assert!((unoccluded - 1.0).abs() < 0.01, "{unoccluded}");
@@ -231,17 +235,12 @@ fn turning_the_environment_turns_the_shadow_with_it() {
     let ctx = common::gpu::context();
     let size = 32;
     let g = ground_gbuffer(size, Grid::new(32).unwrap());
-    let (model, look) = lambert_white();
     let mut texels = vec![[0.0f32; 3]; 64 * 32];
     // A sun 45° above the horizon toward +X (u = 0.75, v = 0.25).
     texels[8 * 64 + 48] = [5000.0; 3];
     let env = Environment::new(64, 32, texels, "a sun");
-    let ids = lookdev::render::scene::covered_object_ids(&g);
-    let stacks = lookdev::material::stack::PackedStacks::pack(&look, ids, &g, std::path::Path::new("ground")).unwrap();
     let left_and_right = |rotation: f32| {
-        let mut renderer = lookdev::render::Renderer::with_model(&ctx, &g, &env, &model).unwrap();
-        renderer.set_stacks(&stacks).unwrap();
-        renderer.set_lighting(Lighting { background: false, rotation_degrees: rotation, ..Lighting::default() });
+        let mut renderer = lambert_white(&ctx, &g, &env, rotation);
         renderer.render_samples(64).unwrap();
         let radiance = renderer.read_radiance().unwrap();
         // The ground just beside the sphere, at x = ∓1.5 (toward −X and toward +X).
