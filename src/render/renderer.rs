@@ -264,11 +264,6 @@ impl Renderer {
         self.respecialize(self.relight.shading.model, self.relight.accumulate)
     }
 
-    /// Whether the g-buffer has visibility, whether or not it is used.
-    pub fn has_visibility(&self) -> bool {
-        self.gbuffer.visibility_side > 0
-    }
-
     /// The side of the visibility grid the relight kernel reads: 0 when off or absent.
     fn visibility_side(&self) -> u32 {
         if self.visibility {

@@ -23,10 +23,6 @@ impl Mesh {
         Mesh { bvh, triangles }
     }
 
-    pub fn triangle_count(&self) -> usize {
-        self.triangles.len()
-    }
-
     /// The unit geometric normal of triangle `index` (counter-clockwise front), or zero for a
     /// degenerate one.
     pub fn normal(&self, index: usize) -> Vec3 {

@@ -148,11 +148,6 @@ impl Visibility {
         let cell = self.grid.cell(direction);
         self.pixel(pixel)[cell / WORD_BITS] >> (cell % WORD_BITS) & 1 == 1
     }
-
-    /// Bytes a pixel's bits take.
-    pub fn bytes_per_pixel(&self) -> usize {
-        self.grid.words() * 4
-    }
 }
 
 /// Cosine-weighted integration over a grid's cells: each cell's directions and solid angles at
@@ -216,10 +211,6 @@ impl Quadrature {
             seen += points.iter().map(|&(d, area)| d.dot(normal).max(0.0) * area).sum::<f32>();
         }
         seen / std::f32::consts::PI
-    }
-
-    pub fn grid(&self) -> Grid {
-        self.grid
     }
 }
 
