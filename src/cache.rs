@@ -190,6 +190,36 @@ impl Entry {
     }
 }
 
+/// Marks an entry as just used, for [`prune`]. Best effort.
+pub fn touch(path: Option<&Path>) {
+    if let Some(file) = path.and_then(|p| std::fs::File::options().append(true).open(p).ok()) {
+        let _ = file.set_modified(std::time::SystemTime::now());
+    }
+}
+
+/// Keeps the folder of `written` within `budget` bytes, removing the least recently used
+/// entries other than `written`. Best effort: what cannot be read or removed stays.
+pub fn prune(written: &Path, budget: u64) {
+    let Some(Ok(entries)) = written.parent().map(std::fs::read_dir) else { return };
+    let mut files: Vec<(std::time::SystemTime, u64, PathBuf)> = entries
+        .flatten()
+        .filter_map(|e| {
+            let meta = e.metadata().ok().filter(|m| m.is_file())?;
+            Some((meta.modified().ok()?, meta.len(), e.path()))
+        })
+        .collect();
+    let mut total: u64 = files.iter().map(|f| f.1).sum();
+    files.sort();
+    for (_, len, path) in files {
+        if total <= budget {
+            break;
+        }
+        if path != written && std::fs::remove_file(&path).is_ok() {
+            total -= len;
+        }
+    }
+}
+
 /// Warns once per process about a damaged cache file, which is then made again.
 fn damaged(path: &Path, problem: &str) {
     static WARNED: AtomicBool = AtomicBool::new(false);

@@ -13,7 +13,7 @@
 use super::distribution::{Distribution, Table, MAX_CELLS};
 use super::{Environment, MAX_TEXEL};
 use crate::cache::{self, Entry};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// The version of the tables' file format *and* of how they are built: bump it whenever
 /// [`Distribution`] gains a field (and [`encode_tables`] / [`decode_tables`] with it) or builds
@@ -77,7 +77,7 @@ pub fn distribution(environment: &Environment, max_image_side: u32, compensated:
     });
     if let Some(distribution) = cached {
         crate::timings::note(|| format!("environment tables: loaded from {}", path_text(&path)));
-        touch(path.as_deref());
+        cache::touch(path.as_deref());
         return distribution;
     }
     let distribution = if compensated {
@@ -87,7 +87,7 @@ pub fn distribution(environment: &Environment, max_image_side: u32, compensated:
     };
     if let Some(path) = &path {
         TABLES.store(path, &key, &encode_tables(&distribution));
-        prune(path);
+        cache::prune(path, FOLDER_BUDGET);
     }
     distribution
 }
@@ -114,45 +114,15 @@ pub fn builtin(name: &str, content_hash: u64, decode: impl FnOnce() -> Environme
     });
     if let Some(environment) = cached {
         crate::timings::note(|| format!("environment: {source} loaded from {}", path_text(&path)));
-        touch(path.as_deref());
+        cache::touch(path.as_deref());
         return environment;
     }
     let environment = decode();
     if let Some(path) = &path {
         BUILTIN.store(path, &key, &encode_texels(&environment));
-        prune(path);
+        cache::prune(path, FOLDER_BUDGET);
     }
     environment
-}
-
-/// Marks an entry as just used, for [`prune`]. Best effort.
-fn touch(path: Option<&Path>) {
-    if let Some(file) = path.and_then(|p| std::fs::File::options().append(true).open(p).ok()) {
-        let _ = file.set_modified(std::time::SystemTime::now());
-    }
-}
-
-/// Keeps the folder of `written` within [`FOLDER_BUDGET`], removing the least recently used
-/// entries other than `written`. Best effort: what cannot be read or removed stays.
-fn prune(written: &Path) {
-    let Some(Ok(entries)) = written.parent().map(std::fs::read_dir) else { return };
-    let mut files: Vec<(std::time::SystemTime, u64, PathBuf)> = entries
-        .flatten()
-        .filter_map(|e| {
-            let meta = e.metadata().ok().filter(|m| m.is_file())?;
-            Some((meta.modified().ok()?, meta.len(), e.path()))
-        })
-        .collect();
-    let mut total: u64 = files.iter().map(|f| f.1).sum();
-    files.sort();
-    for (_, len, path) in files {
-        if total <= FOLDER_BUDGET {
-            break;
-        }
-        if path != written && std::fs::remove_file(&path).is_ok() {
-            total -= len;
-        }
-    }
 }
 
 /// Little-endian words, read with every length checked against what is left.
@@ -295,7 +265,7 @@ pub fn file_texels(
     if let Some(texels) = path.as_deref().and_then(|path| FILE_TEXELS.load(path, &key)).and_then(|p| decode_texels(&p))
     {
         crate::timings::note(|| format!("environment: {name} loaded from {}", path_text(&path)));
-        touch(path.as_deref());
+        cache::touch(path.as_deref());
         return Ok(texels);
     }
     let (width, height, texels) = decode()?;
@@ -304,7 +274,7 @@ pub fn file_texels(
         put(&mut payload, [width, height]);
         put(&mut payload, texels.iter().flatten().map(|v| v.to_bits()));
         FILE_TEXELS.store(path, &key, &payload);
-        prune(path);
+        cache::prune(path, FOLDER_BUDGET);
     }
     Ok((width, height, texels))
 }
