@@ -15,9 +15,9 @@
 
 mod common;
 
+use common::blender::{blender, cryptomatte, mean, read_channels, run_blender};
 use common::cli::{assert_bad_input, assert_success, stderr};
 use lookdev::gbuffer::{GBuffer, SourceOptions};
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
@@ -109,32 +109,6 @@ const CAMERA: &str = "0.4,-7.5,2.8";
 /// Blender's equirectangular centre is +X; lookdev's is −Z, so the same map is turned −90°.
 const ROTATION: &str = "-90";
 
-fn blender() -> Option<PathBuf> {
-    match Command::new("blender").arg("--version").output() {
-        Ok(output) if output.status.success() => Some(PathBuf::from("blender")),
-        _ => {
-            assert!(
-                std::env::var_os("CI").is_none(),
-                "Blender is needed for these tests in CI (apt-get install blender)"
-            );
-            eprintln!("Blender is not installed (apt-get install blender): test skipped");
-            None
-        }
-    }
-}
-
-fn run_blender(blender: &Path, args: &[&str]) {
-    // Without --python-exit-code, Blender exits 0 whatever the script raised.
-    let output = Command::new(blender).args(["-b", "--python-exit-code", "2"]).args(args).output().unwrap();
-    let text = String::from_utf8_lossy(&output.stdout);
-    assert!(
-        output.status.success() && !text.contains("Error:"),
-        "blender {}: {text}{}",
-        args.join(" "),
-        stderr(&output)
-    );
-}
-
 /// The three renders, made once for the tests that share them, in the target's scratch folder.
 struct Renders {
     dir: PathBuf,
@@ -184,96 +158,13 @@ impl Renders {
     }
 }
 
-/// Every channel of an EXR's first part as floats, with its text attributes.
-fn read_channels(path: &str) -> (BTreeMap<String, Vec<f32>>, BTreeMap<String, String>) {
-    use exr::prelude::*;
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .unwrap();
-    let channels = image
-        .layer_data
-        .channel_data
-        .list
-        .iter()
-        .map(|c| (c.name.to_string(), c.sample_data.values_as_f32().collect()))
-        .collect();
-    let text = image
-        .attributes
-        .other
-        .iter()
-        .chain(image.layer_data.attributes.other.iter())
-        .filter_map(|(k, v)| match v {
-            AttributeValue::Text(t) => Some((k.to_string(), t.to_string())),
-            _ => None,
-        })
-        .collect();
-    (channels, text)
-}
-
-/// A Cryptomatte layer decoded from the specification: per manifest name, per pixel, its
-/// coverage (rank pairs whose id is the name's hash, stored as float bits with the exponent
-/// kept in 1..=254).
-fn cryptomatte(
-    channels: &BTreeMap<String, Vec<f32>>,
-    text: &BTreeMap<String, String>,
-    layer: &str,
-) -> Vec<(String, Vec<f32>)> {
-    let key = text
-        .iter()
-        .find(|(k, v)| k.ends_with("/name") && *v == layer)
-        .map(|(k, _)| k.trim_end_matches("/name").to_string())
-        .unwrap();
-    let manifest: serde_json::Map<String, serde_json::Value> =
-        serde_json::from_str(&text[&format!("{key}/manifest")]).unwrap();
-    let pixels = WIDTH * HEIGHT;
-    manifest
-        .iter()
-        .map(|(name, hex)| {
-            let hash = u32::from_str_radix(hex.as_str().unwrap(), 16).unwrap();
-            let exponent = ((hash >> 23) & 0xff).clamp(1, 254);
-            let id = (hash & 0x807f_ffff) | (exponent << 23);
-            let mut coverage = vec![0.0f32; pixels];
-            for rank in 0.. {
-                let channel = |c: &str| channels.get(&format!("{layer}{rank:02}.{c}"));
-                let (Some(r), Some(g), Some(b), Some(a)) = (channel("r"), channel("g"), channel("b"), channel("a"))
-                else {
-                    break;
-                };
-                for p in 0..pixels {
-                    for (ids, covs) in [(r, g), (b, a)] {
-                        if ids[p].to_bits() == id {
-                            coverage[p] += covs[p];
-                        }
-                    }
-                }
-            }
-            (name.clone(), coverage)
-        })
-        .collect()
-}
-
-/// Mean RGB of `image` over `pixels`.
-fn mean(image: &BTreeMap<String, Vec<f32>>, prefix: &str, pixels: &[usize]) -> [f64; 3] {
-    let mut sum = [0.0f64; 3];
-    for (k, c) in ["R", "G", "B"].iter().enumerate() {
-        let values = &image[&format!("{prefix}{c}")];
-        sum[k] = pixels.iter().map(|&p| values[p] as f64).sum::<f64>() / pixels.len() as f64;
-    }
-    sum
-}
-
 #[test]
 fn blender_renders_relight_like_cycles_and_decode_like_the_specification() {
     let Some(renders) = Renders::get() else { return };
     let d = renders.dir.as_path();
     let (plain, plain_text) = read_channels(&renders.path("plain.exr"));
-    let objects = cryptomatte(&plain, &plain_text, "ViewLayer.CryptoObject");
-    let materials = cryptomatte(&plain, &plain_text, "ViewLayer.CryptoMaterial");
+    let objects = cryptomatte(&plain, &plain_text, "ViewLayer.CryptoObject", WIDTH * HEIGHT);
+    let materials = cryptomatte(&plain, &plain_text, "ViewLayer.CryptoMaterial", WIDTH * HEIGHT);
     let pixels = WIDTH * HEIGHT;
 
     // Ids, coverage and mattes, against the decode above, where one object covers the pixel.

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod albedo;
+pub mod blender;
 pub mod cli;
 pub mod display;
 pub mod gltf;
