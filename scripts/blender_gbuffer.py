@@ -2,7 +2,7 @@
 
     blender -b shot.blend --python-exit-code 2 --python scripts/blender_gbuffer.py -- --out shot.exr
         [--size W H] [--samples N] [--view-layer NAME] [--camera NAME]
-        [--matte-material NAME]... [--matte-attribute NAME]...
+        [--matte-material NAME]... [--matte-attribute NAME]... [--visibility SIDE|off]
 
 It renders the scene's active camera with Cycles into one multilayer OpenEXR holding what
 lookdev reads (docs/formats.md#production-renders):
@@ -10,6 +10,10 @@ lookdev reads (docs/formats.md#production-renders):
 - the Normal and Position passes (world space, Z up), and Depth;
 - Cryptomatte object, material and asset layers (ids, coverage, names and mattes);
 - the camera, in the render's metadata note, so that lookdev needs no --camera-position;
+- the scene's shadow-casting triangles as they render (modifiers at render levels, instances
+  made real), in lookdev's Y-up world, beside the EXR as NAME.occluders.glb and named in the
+  note: lookdev traces each pixel's shadows and occlusion through them from the Position pass
+  (docs/formats.md#occluders), over SIDE² directions (--visibility, default 32);
 - custom mattes on request, as shader AOVs named mask_<name>: 1 on the surfaces of each
   --matte-material, and the value of each --matte-attribute (a named attribute of the
   geometry, such as a painted vertex group or a colour attribute's first channel).
@@ -19,7 +23,12 @@ samples (16, enough to antialias coverage). The .blend file is not changed; noth
 """
 
 import argparse
+import array
+import json
+import os
+import struct
 import sys
+import urllib.parse
 
 import bpy
 import mathutils
@@ -35,6 +44,12 @@ def arguments():
     parser.add_argument("--camera", help="the camera object to render (default: the scene's)")
     parser.add_argument("--matte-material", action="append", default=[], help="a material to matte")
     parser.add_argument("--matte-attribute", action="append", default=[], help="a named attribute to matte")
+    parser.add_argument(
+        "--visibility",
+        default="32",
+        choices=["8", "16", "32", "64", "off"],
+        help="directions a side lookdev traces shadows over, or off to write no occluders (default 32)",
+    )
     return parser.parse_args(argv)
 
 
@@ -89,6 +104,120 @@ def camera_note(camera):
     return f"lookdev.camera position={numbers(position)} forward={numbers(forward)} projection={projection}"
 
 
+# Kinds of object Cycles renders as triangles.
+GEOMETRY = {"MESH", "CURVE", "SURFACE", "META", "FONT", "CURVES", "POINTCLOUD", "VOLUME"}
+
+
+def render_visibility(scene, view_layer):
+    """Makes the scene evaluate as it renders: objects and collections shown as in the render,
+    modifiers on and subdivided as in the render. Nothing is saved, so the .blend is unchanged."""
+    for collection in bpy.data.collections:
+        collection.hide_viewport = collection.hide_render
+
+    def show(layer_collection):
+        layer_collection.hide_viewport = False
+        for child in layer_collection.children:
+            show(child)
+
+    show(view_layer.layer_collection)
+    for obj in view_layer.objects:
+        obj.hide_viewport = obj.hide_render
+        obj.hide_set(False, view_layer=view_layer)
+        for modifier in obj.modifiers:
+            modifier.show_viewport = modifier.show_render
+            if hasattr(modifier, "render_levels"):
+                modifier.levels = modifier.render_levels
+
+
+def shadow_casters(view_layer):
+    """The triangles of every object instance that casts shadows: per instance, its vertices
+    (float32 x, y, z in the object's space), its corner indices (uint32) and its world matrix."""
+    depsgraph = view_layer.depsgraph
+    depsgraph.update()
+    casters = []
+    for instance in depsgraph.object_instances:
+        obj = instance.object
+        if obj.type not in GEOMETRY or not obj.visible_shadow:
+            continue
+        try:
+            mesh = obj.to_mesh()
+        except RuntimeError:
+            continue
+        if mesh is None:
+            continue
+        mesh.calc_loop_triangles()
+        vertices = array.array("f", [0.0]) * (len(mesh.vertices) * 3)
+        mesh.vertices.foreach_get("co", vertices)
+        corners = array.array("I", [0]) * (len(mesh.loop_triangles) * 3)
+        mesh.loop_triangles.foreach_get("vertices", corners)
+        obj.to_mesh_clear()
+        if corners:
+            casters.append((vertices, corners, instance.matrix_world.copy()))
+    return casters
+
+
+def write_glb(path, casters):
+    """A binary glTF with a mesh and a node for each caster, under a root node that turns
+    Blender's Z-up world to glTF's Y up, (x, y, z) -> (x, z, -y). Written beside, then renamed
+    into place."""
+    if sys.byteorder != "little":
+        fail("writing occluders needs a little-endian machine")
+    binary = bytearray()
+    accessors, views, meshes, nodes = [], [], [], []
+
+    def view(data, target):
+        views.append({"buffer": 0, "byteOffset": len(binary), "byteLength": len(data), "target": target})
+        binary.extend(data)
+        return len(views) - 1
+
+    for vertices, corners, world in casters:
+        xs, ys, zs = vertices[0::3], vertices[1::3], vertices[2::3]
+        accessors.append({
+            "bufferView": view(vertices.tobytes(), 34962),
+            "componentType": 5126,
+            "count": len(vertices) // 3,
+            "type": "VEC3",
+            "min": [min(xs), min(ys), min(zs)],
+            "max": [max(xs), max(ys), max(zs)],
+        })
+        accessors.append({
+            "bufferView": view(corners.tobytes(), 34963),
+            "componentType": 5125,
+            "count": len(corners),
+            "type": "SCALAR",
+        })
+        meshes.append({"primitives": [{"attributes": {"POSITION": len(accessors) - 2}, "indices": len(accessors) - 1}]})
+        columns = [world[row][column] for column in range(4) for row in range(4)]
+        nodes.append({"mesh": len(meshes) - 1, "matrix": columns})
+    root = {"name": "Z up", "matrix": [1, 0, 0, 0, 0, 0, -1, 0, 0, 1, 0, 0, 0, 0, 0, 1]}
+    root["children"] = list(range(1, len(nodes) + 1))
+    document = {
+        "asset": {"version": "2.0", "generator": "lookdev blender_gbuffer.py"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [root] + nodes,
+        "meshes": meshes,
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{"byteLength": len(binary)}],
+    }
+    text = json.dumps(document, separators=(",", ":")).encode()
+    text += b" " * (-len(text) % 4)
+    binary.extend(b"\0" * (-len(binary) % 4))
+    length = 12 + 8 + len(text) + 8 + len(binary)
+    temporary = path + ".part"
+    with open(temporary, "wb") as out:
+        out.write(struct.pack("<4sII", b"glTF", 2, length))
+        out.write(struct.pack("<I4s", len(text), b"JSON") + text)
+        out.write(struct.pack("<I4s", len(binary), b"BIN\0") + binary)
+    os.replace(temporary, path)
+
+
+def occluders_path(out):
+    stem = out[: -len(".exr")] if out.lower().endswith(".exr") else out
+    return stem + ".occluders.glb"
+
+
 def main():
     args = arguments()
     scene = bpy.context.scene
@@ -135,8 +264,21 @@ def main():
         for material in bpy.data.materials:
             matte_attribute(material, name)
 
+    note = camera_note(scene.camera)
+    if args.visibility != "off":
+        render_visibility(scene, view_layer)
+        casters = shadow_casters(view_layer)
+        if not casters:
+            print("blender_gbuffer.py: no object casts shadows; no occluders are written")
+        else:
+            path = occluders_path(bpy.path.abspath(args.out))
+            write_glb(path, casters)
+            triangles = sum(len(corners) for _, corners, _ in casters) // 3
+            print(f"blender_gbuffer.py: {triangles} shadow-casting triangles written to {path}")
+            name = urllib.parse.quote(os.path.basename(path))
+            note += f" occluders={name} visibility={args.visibility}"
     scene.render.use_stamp_note = True
-    scene.render.stamp_note_text = camera_note(scene.camera)
+    scene.render.stamp_note_text = note
     scene.render.use_compositing = False
     settings = scene.render.image_settings
     settings.file_format = "OPEN_EXR_MULTILAYER"

@@ -627,7 +627,7 @@ fn preset_complex_ior_must_match_its_base_color() {
 #[test]
 fn gbuffer_tables_and_object_names_read_write_back_and_resolve() {
     let text = "[gbuffer]\nfile = \"shot.exr\"\nlayer = \"ViewLayer\"\nup = \"z\"\ncamera_position = [0.5, -7.0, 2.5]\n\
-                normal = \"Nw\"\nposition = \"Pw\"\ncoverage = \"alpha\"\nid = \"objectIndex\"\nmasks = [\"matte_a\", \"matte_b\"]\n\n\
+                occluders = \"shot.occluders.glb\"\nnormal = \"Nw\"\nposition = \"Pw\"\ncoverage = \"alpha\"\nid = \"objectIndex\"\nmasks = [\"matte_a\", \"matte_b\"]\n\n\
                 [[object]]\nname = \"Sphere.001\"\n[[object.layer]]\npreset = \"gold\"\n\n\
                 [[object]]\nid = 3\n[[object.layer]]\npreset = \"chrome\"\n";
     let look = Look::parse(text, Path::new(SHOT)).unwrap();
@@ -636,6 +636,7 @@ fn gbuffer_tables_and_object_names_read_write_back_and_resolve() {
     assert_eq!(g.source.layer.as_deref(), Some("ViewLayer"));
     assert_eq!(g.source.up, Some(lookdev::gbuffer::Up::Z));
     assert_eq!(g.source.camera_position, Some(glam::Vec3::new(0.5, -7.0, 2.5)));
+    assert_eq!(g.source.occluders.as_deref(), Some(Path::new("looks/shot.occluders.glb")), "relative to the look");
     assert_eq!(g.source.channels.normal.as_deref(), Some("Nw"));
     assert_eq!(g.source.channels.masks, ["matte_a", "matte_b"]);
     assert_eq!((look.objects[0].name.as_deref(), look.objects[0].id), (Some("Sphere.001"), None));
@@ -654,7 +655,7 @@ fn gbuffer_tables_and_object_names_read_write_back_and_resolve() {
     assert_eq!(warnings.len(), 1);
     assert!(
         warnings[0].contains(
-            "looks/shot.toml:17: this stack claims object 3 'Sphere.001', which the stack at line 12 claims too"
+            "looks/shot.toml:18: this stack claims object 3 'Sphere.001', which the stack at line 13 claims too"
         ),
         "{}",
         warnings[0]
@@ -664,7 +665,7 @@ fn gbuffer_tables_and_object_names_read_write_back_and_resolve() {
         Path::new("g.exr"),
     );
     let message = unknown.unwrap_err().to_string();
-    assert_eq!(message, "looks/shot.toml:12: no object named 'Sphere.001' in g.exr (it has Cube (3))");
+    assert_eq!(message, "looks/shot.toml:13: no object named 'Sphere.001' in g.exr (it has Cube (3))");
 
     assert_eq!(error("[gbuffer]\nup = \"x\"\n"), "looks/shot.toml:2: up = 'x': expected \"y\" or \"z\"");
     assert_eq!(

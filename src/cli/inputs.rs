@@ -101,6 +101,11 @@ pub struct GBufferArgs {
     /// visibility (its shadows and occlusion), for comparison.
     #[arg(long)]
     pub no_visibility: bool,
+    /// The scene's triangles as glTF (.glb or .gltf, Y up, the g-buffer's units), to trace the
+    /// shadows and occlusion of a production render from its positions (P or Position); by
+    /// default, the file the header names (lookdev's Blender script writes one).
+    #[arg(long, value_name = "FILE.glb")]
+    pub occluders: Option<PathBuf>,
 }
 
 fn parse_point(text: &str) -> std::result::Result<glam::Vec3, String> {
@@ -122,6 +127,8 @@ impl GBufferArgs {
             up: self.up,
             camera_position: self.camera_position,
             channels,
+            occluders: self.occluders.clone(),
+            no_visibility: false,
         };
         Ok(GBufferSpec {
             file: self.gbuffer.clone(),

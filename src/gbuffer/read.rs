@@ -3,11 +3,13 @@
 
 use std::path::Path;
 
-use super::source::{self, Detected, SourceOptions};
+use super::source::occluders::Occluders;
+use super::source::{self, Detected, SourceOptions, Surfaces};
 use super::validate;
 use super::GBuffer;
 use crate::input::{self, Kind};
-use crate::Result;
+use crate::visibility::{Grid, DEFAULT_SIDE};
+use crate::{Error, Result};
 
 /// A g-buffer as read: the validated buffer, what its file was detected as, and the fix-up and
 /// translation warnings (one line each, naming the file).
@@ -33,8 +35,43 @@ impl GBuffer {
 
     /// Reads a g-buffer file as `options` say, returning the warnings rather than printing them.
     /// See the module documentation for the format, the sources, the errors and the fix-ups.
+    /// A production render with world positions and occluders (`options.occluders`, else the
+    /// file the header's note names) and no stored visibility gets one traced through them
+    /// ([`crate::visibility::occluders`]).
     pub fn read_with(path: &Path, options: &SourceOptions) -> Result<Read> {
-        GBuffer::decode_with(&input::read(path, Kind::GBuffer)?, path, options)
+        let (mut read, surfaces) = decode(&input::read(path, Kind::GBuffer)?, path, options)?;
+        if options.no_visibility {
+            read.gbuffer.visibility = None;
+            return Ok(read);
+        }
+        let occluders = match &options.occluders {
+            Some(file) => Some(Occluders { file: file.clone(), side: None, from: "--occluders".into() }),
+            None => surfaces.occluders,
+        };
+        let Some(occluders) = occluders else { return Ok(read) };
+        if read.gbuffer.visibility.is_some() {
+            read.warnings.push(format!(
+                "{}: it stores its visibility, so the occluders from {} are not traced",
+                path.display(),
+                occluders.from
+            ));
+            return Ok(read);
+        }
+        let Some(positions) = surfaces.positions else {
+            return Err(Error::input_file(
+                path,
+                format!(
+                    "occluders from {} need world positions to trace from, and the file has no P or Position layer",
+                    occluders.from
+                ),
+            ));
+        };
+        let grid = Grid::new(occluders.side.unwrap_or(DEFAULT_SIDE)).map_err(Error::input)?;
+        let traced = crate::visibility::occluders::trace_positions(&read.gbuffer, path, &positions, &occluders, grid)?;
+        read.gbuffer.visibility = Some(traced.visibility);
+        read.detected.from.push(("visibility".into(), traced.how));
+        read.warnings.extend(traced.warnings);
+        Ok(read)
     }
 
     /// Decodes and validates the bytes of a g-buffer file; `path` names it in messages. Needs
@@ -45,10 +82,16 @@ impl GBuffer {
 
     /// [`GBuffer::decode`], as `options` say.
     pub fn decode_with(bytes: &[u8], path: &Path, options: &SourceOptions) -> Result<Read> {
-        let file = source::raw::decode(bytes, path)?;
-        let (raw, detected, mut warnings) = source::translate(file, options, path)?;
-        let (gbuffer, fixes) = validate::build(path, raw)?;
-        warnings.extend(fixes);
-        Ok(Read { gbuffer, detected, warnings })
+        decode(bytes, path, options).map(|(read, _)| read)
     }
+}
+
+/// A g-buffer decoded and validated, with what its file offers for tracing visibility.
+fn decode(bytes: &[u8], path: &Path, options: &SourceOptions) -> Result<(Read, Surfaces)> {
+    let file = source::raw::decode(bytes, path)?;
+    let (mut raw, detected, mut warnings) = source::translate(file, options, path)?;
+    let surfaces = std::mem::take(&mut raw.surfaces);
+    let (gbuffer, fixes) = validate::build(path, raw)?;
+    warnings.extend(fixes);
+    Ok((Read { gbuffer, detected, warnings }, surfaces))
 }

@@ -27,6 +27,8 @@ pub(crate) struct RawImage {
     pub object_name_attributes: Vec<(String, Option<String>)>,
     /// Header text attributes named `maskName.<mask>`, by mask name.
     pub mask_names: BTreeMap<String, String>,
+    /// What the file offers for tracing visibility; validation leaves it to the reader.
+    pub surfaces: super::source::Surfaces,
 }
 
 /// A normal shorter than this is "clearly empty": it marks background in files without `A`, and
@@ -569,6 +571,7 @@ mod tests {
             channels: channels.into_iter().map(|(name, samples)| (name.to_string(), samples)).collect(),
             object_name_attributes: Vec::new(),
             mask_names: BTreeMap::new(),
+            surfaces: Default::default(),
         }
     }
 

@@ -355,6 +355,11 @@ impl Look {
                 input::float(p.z)
             ));
         }
+        if let Some(file) = &source.occluders {
+            let folder = self.file.as_deref().and_then(Path::parent).unwrap_or(Path::new(""));
+            let relative = file.strip_prefix(folder).unwrap_or(file);
+            body.push(format!("occluders = {}", input::quoted(&relative.to_string_lossy())));
+        }
         let c = &source.channels;
         for (key, value) in [
             ("normal", &c.normal),
@@ -484,6 +489,7 @@ struct GBufferFile {
     layer: Option<Field>,
     up: Option<Field>,
     camera_position: Option<Field>,
+    occluders: Option<Field>,
     normal: Option<Field>,
     position: Option<Field>,
     view: Option<Field>,
@@ -595,6 +601,8 @@ fn gbuffer(src: &Source, raw: Option<GBufferFile>, folder: &Path) -> crate::Resu
             up: src.read("up", &raw.up, |key, value| Up::parse(&input::text(key, value)?))?,
             camera_position,
             channels,
+            occluders: text("occluders", &raw.occluders)?.map(|f| folder.join(f)),
+            no_visibility: false,
         },
     })
 }

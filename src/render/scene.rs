@@ -207,7 +207,8 @@ pub fn read_gbuffer(spec: &GBufferSpec, look: &mut Look, quiet: bool) -> Result<
     }
     let (gbuffer, name) = match file {
         Some(path) => {
-            let read = GBuffer::read_with(&path, &spec.source.over(&look.gbuffer.source))?;
+            let options = SourceOptions { no_visibility: spec.ignore_visibility, ..spec.source.clone() };
+            let read = GBuffer::read_with(&path, &options.over(&look.gbuffer.source))?;
             if !quiet && read.detected.source != Source::Lookdev {
                 eprintln!("lookdev: {}", crate::printable(&read.detected.summary(&path)));
             }
@@ -240,12 +241,33 @@ pub fn dark_render_warnings(
             gbuffer_name.display()
         ));
     }
+    warnings.extend(blind_objects(gbuffer).into_iter().map(|finding| format!("{}: {finding}", gbuffer_name.display())));
     if environment.texels.iter().flatten().all(|&v| v == 0.0) {
         warnings.push(format!("{}: every texel is 0, so the render is black", environment.source));
     } else if intensity == 0.0 {
         warnings.push("the environment's intensity is 0, so the render is black".to_string());
     }
     warnings
+}
+
+/// Share of an object's pixels that see no sky above which its visibility is suspect.
+pub const BLIND_SHARE: f32 = 0.5;
+
+/// One line for each object more than [`BLIND_SHARE`] of whose pixels see the environment along
+/// no direction, so render black under any light.
+pub fn blind_objects(gbuffer: &GBuffer) -> Vec<String> {
+    crate::visibility::blind_shares(gbuffer)
+        .into_iter()
+        .filter(|&(_, share)| share > BLIND_SHARE)
+        .map(|(id, share)| {
+            let name = gbuffer.object_names.get(&id).map(|n| format!(" '{n}'")).unwrap_or_default();
+            format!(
+                "object {id}{name}: {:.0}% of its pixels see the sky along no direction, so they render black in any light \
+                 (was its visibility traced from inside the surfaces?); --no-visibility renders without it",
+                share * 100.0
+            )
+        })
+        .collect()
 }
 
 /// The distinct object ids of the pixels that are shaded (coverage > 0), ascending.

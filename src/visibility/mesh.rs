@@ -4,7 +4,7 @@ use super::Occluder;
 use glam::{Vec3, Vec3A};
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::cwbvh::CwBvh;
-use obvhs::ray::Ray;
+use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
 
@@ -27,6 +27,20 @@ impl Mesh {
     /// degenerate one.
     pub fn normal(&self, index: usize) -> Vec3 {
         Vec3::from(self.triangles[index].compute_normal())
+    }
+
+    /// The nearest hit of the ray from `origin` along the unit `direction` within `reach`: its
+    /// distance and the triangle's index.
+    pub fn nearest_hit(&self, origin: Vec3, direction: Vec3, reach: f32) -> Option<(f32, usize)> {
+        if self.triangles.is_empty() {
+            return None;
+        }
+        let ray = Ray::new(Vec3A::from(origin), Vec3A::from(direction), 0.0, reach);
+        let mut hit = RayHit::none();
+        let triangle = |id: usize| self.bvh.primitive_indices[id] as usize;
+        self.bvh
+            .ray_traverse(ray, &mut hit, |ray, id| self.triangles[triangle(id)].intersect(ray))
+            .then(|| (hit.t, triangle(hit.primitive_id as usize)))
     }
 }
 

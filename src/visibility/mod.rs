@@ -11,6 +11,7 @@
 //! error at each size.
 
 mod mesh;
+pub mod occluders;
 mod trace;
 
 pub use mesh::Mesh;
@@ -239,6 +240,41 @@ pub fn occlusion(gbuffer: &crate::gbuffer::GBuffer) -> Vec<f32> {
         }
     });
     out
+}
+
+/// Per object, the share of its covered pixels whose visibility sees the environment along no
+/// direction at all, so that they render black under any light: most often a visibility traced
+/// from inside the surfaces. Empty without visibility.
+pub fn blind_shares(gbuffer: &crate::gbuffer::GBuffer) -> std::collections::BTreeMap<u32, f32> {
+    let mut counts: std::collections::BTreeMap<u32, (usize, usize)> = Default::default();
+    let Some(visibility) = &gbuffer.visibility else { return Default::default() };
+    for p in (0..gbuffer.pixel_count()).filter(|&p| gbuffer.coverage[p] > 0.0) {
+        let (blind, all) = counts.entry(gbuffer.object_id[p]).or_default();
+        *blind += usize::from(visibility.pixel(p).iter().all(|&w| w == 0));
+        *all += 1;
+    }
+    counts.into_iter().map(|(id, (blind, all))| (id, blind as f32 / all as f32)).collect()
+}
+
+/// The share of environment samples, among those above a covered pixel's horizon, that its
+/// visibility blocks: what a sampler that skipped blocked directions could save at most.
+/// `sample` maps a point of the unit square to a world direction as the environment sampler
+/// draws it; each covered pixel takes `per_side`² stratified points.
+pub fn blocked_share(gbuffer: &crate::gbuffer::GBuffer, sample: impl Fn(Vec2) -> Vec3, per_side: u32) -> Option<f64> {
+    let visibility = gbuffer.visibility.as_ref()?;
+    let (mut blocked, mut above) = (0u64, 0u64);
+    for p in (0..gbuffer.pixel_count()).filter(|&p| gbuffer.coverage[p] > 0.0) {
+        let normal = Vec3::from(gbuffer.normal[p]);
+        for k in 0..per_side * per_side {
+            let u = Vec2::new((k % per_side) as f32 + 0.5, (k / per_side) as f32 + 0.5) / per_side as f32;
+            let d = sample(u);
+            if d.dot(normal) > 0.0 {
+                above += 1;
+                blocked += u64::from(!visibility.seen(p, d));
+            }
+        }
+    }
+    (above > 0).then(|| blocked as f64 / above as f64)
 }
 
 #[cfg(test)]

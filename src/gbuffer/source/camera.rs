@@ -27,7 +27,7 @@ pub struct Camera {
 /// The text attribute lookdev's Blender script writes (Blender's render metadata "Note"):
 /// `lookdev.camera position=X,Y,Z forward=X,Y,Z projection=perspective|orthographic`.
 pub const NOTE_ATTRIBUTE: &str = "Note";
-const NOTE_PREFIX: &str = "lookdev.camera";
+pub const NOTE_PREFIX: &str = "lookdev.camera";
 
 /// The camera the header records: OpenEXR's `worldToCamera` (with `worldToNDC` telling an
 /// orthographic camera from a perspective one), else lookdev's note. Matrices are stored for

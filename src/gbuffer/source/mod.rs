@@ -12,10 +12,11 @@
 
 pub mod camera;
 pub mod cryptomatte;
+pub mod occluders;
 pub mod raw;
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
@@ -117,6 +118,11 @@ pub struct SourceOptions {
     /// positions when the header does not record it.
     pub camera_position: Option<Vec3>,
     pub channels: Channels,
+    /// The scene's triangles (a glTF file), to trace the visibility through from the file's
+    /// positions (`--occluders`); by default, the file the header's note names.
+    pub occluders: Option<PathBuf>,
+    /// Reads no visibility and traces none (`--no-visibility`).
+    pub no_visibility: bool,
 }
 
 impl SourceOptions {
@@ -137,6 +143,8 @@ impl SourceOptions {
                 id: c.id.clone().or_else(|| b.id.clone()),
                 masks: if c.masks.is_empty() { b.masks.clone() } else { c.masks.clone() },
             },
+            occluders: self.occluders.clone().or_else(|| base.occluders.clone()),
+            no_visibility: self.no_visibility || base.no_visibility,
         }
     }
 }
@@ -186,6 +194,16 @@ impl Detected {
             from.join("; ")
         )
     }
+}
+
+/// What a production render offers for tracing its visibility when it is read
+/// ([`crate::visibility::occluders`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Surfaces {
+    /// World positions in lookdev's frame, coverage divided out, where the file has them.
+    pub positions: Option<Vec<Vec3>>,
+    /// The occluders its header names.
+    pub occluders: Option<occluders::Occluders>,
 }
 
 /// The channels of a file merged from its parts, with its header's attributes.
@@ -398,7 +416,14 @@ fn lookdev(merged: Merged, options: &SourceOptions) -> (RawImage, Detected, Vec<
         .iter()
         .filter_map(|(name, value)| Some((name.strip_prefix(super::MASK_NAME_PREFIX)?.to_string(), value.clone())))
         .collect();
-    let raw = RawImage { width: merged.width, height: merged.height, channels, object_name_attributes, mask_names };
+    let raw = RawImage {
+        width: merged.width,
+        height: merged.height,
+        channels,
+        object_name_attributes,
+        mask_names,
+        surfaces: Surfaces::default(),
+    };
     let detected = Detected { source: Source::Lookdev, layer: merged.part, up, from: Vec::new() };
     (raw, detected, Vec::new())
 }
@@ -646,12 +671,18 @@ fn other(
             }
         }
     }
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let surfaces = Surfaces {
+        positions: position.as_ref().map(|(_, names)| unfiltered(converted(names))),
+        occluders: occluders::from_note(&merged.text, folder).map_err(bad)?,
+    };
     let raw = RawImage {
         width: merged.width,
         height: merged.height,
         channels: out,
         object_name_attributes: object_names,
         mask_names,
+        surfaces,
     };
     Ok((raw, Detected { source, layer, up, from }))
 }

@@ -1,0 +1,321 @@
+//! Shadows on a Blender scene, end to end: a ground, a gold ball, an open red box and a red ring
+//! lying on the ground (concave, stacked and touching objects), lit by the built-in studio
+//! environment. `scripts/blender_gbuffer.py` writes the g-buffer and the scene's triangles;
+//! `lookdev render` traces the shadows through them with nothing else to run. Each object's mean
+//! radiance must match Cycles' direct light with shadows (no bounces) within 3%, and without
+//! the shadows it must not. Without Blender these tests say so and pass, except in CI.
+
+mod common;
+
+use common::blender::{blender, cryptomatte, mean, read_channels, run_blender};
+use common::cli::{assert_bad_input, assert_success, stderr};
+use common::gltf::{cube, Gltf};
+use serde_json::json;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+
+const WIDTH: usize = 160;
+const HEIGHT: usize = 120;
+
+/// Builds the scene and, by mode, saves it (`blend`) or renders Cycles' direct light with
+/// shadows (`beauty`).
+const SCENE: &str = r#"
+import bpy, bmesh, sys
+mode, out, environment = sys.argv[sys.argv.index("--") + 1:]
+bpy.ops.wm.read_factory_settings(use_empty=True)
+scene = bpy.context.scene
+scene.render.engine = 'CYCLES'
+scene.cycles.device = 'CPU'
+scene.cycles.use_denoising = False
+scene.cycles.use_adaptive_sampling = False
+scene.render.resolution_x, scene.render.resolution_y = 160, 120
+scene.render.resolution_percentage = 100
+def material(name, color, metallic, roughness):
+    m = bpy.data.materials.new(name)
+    m.use_nodes = True
+    p = m.node_tree.nodes["Principled BSDF"]
+    p.distribution = 'GGX'
+    p.inputs["Base Color"].default_value = (*color, 1)
+    p.inputs["Metallic"].default_value = metallic
+    p.inputs["Roughness"].default_value = roughness
+    p.inputs["Specular"].default_value = 0.5
+    return m
+red = material("Red Paint", (0.8, 0.1, 0.05), 0.0, 0.4)
+gold = material("Gold", (1.0, 0.766, 0.336), 1.0, 0.3)
+grey = material("Grey", (0.5, 0.5, 0.5), 0.0, 0.6)
+def finish(name, mat):
+    o = bpy.context.object
+    o.name = name
+    o.data.materials.append(mat)
+    return o
+bpy.ops.mesh.primitive_plane_add(size=8, location=(0, 0, 0)); finish("Ground", grey)
+bpy.ops.mesh.primitive_uv_sphere_add(radius=0.7, location=(-1.3, 0.3, 0.7), segments=64, ring_count=32)
+bpy.ops.object.shade_smooth(); finish("Ball", gold)
+# An open box: a cube without its top face, given walls by a solidify modifier.
+bpy.ops.mesh.primitive_cube_add(size=1.4, location=(0.9, 0.4, 0.7))
+box = finish("Box", red)
+box.rotation_euler = (0, 0, 0.4)
+bm = bmesh.new(); bm.from_mesh(box.data)
+bm.faces.ensure_lookup_table()
+top = [f for f in bm.faces if f.normal.z > 0.9]
+bmesh.ops.delete(bm, geom=top, context='FACES')
+bm.to_mesh(box.data); bm.free()
+solid = box.modifiers.new("walls", 'SOLIDIFY'); solid.thickness = 0.08
+bpy.ops.mesh.primitive_torus_add(major_radius=0.45, minor_radius=0.15, location=(-0.1, -1.2, 0.15))
+bpy.ops.object.shade_smooth(); finish("Ring", red)
+camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+scene.collection.objects.link(camera)
+scene.camera = camera
+camera.location = (0.3, -6.5, 4.2)
+camera.rotation_euler = (0.98, 0, 0.04)
+world = bpy.data.worlds.new("World")
+scene.world = world
+world.use_nodes = True
+texture = world.node_tree.nodes.new("ShaderNodeTexEnvironment")
+texture.image = bpy.data.images.load(environment)
+world.node_tree.links.new(texture.outputs["Color"], world.node_tree.nodes["Background"].inputs["Color"])
+layer = scene.view_layers[0]
+layer.cycles.denoising_store_passes = False
+settings = scene.render.image_settings
+scene.render.filepath = out
+if mode == "blend":
+    bpy.ops.wm.save_as_mainfile(filepath=out)
+elif mode == "beauty":
+    scene.cycles.samples = 256
+    scene.cycles.max_bounces = 0
+    settings.file_format = 'OPEN_EXR'
+    settings.color_depth = '32'
+    bpy.ops.render.render(write_still=True)
+"#;
+
+/// The materials as lookdev sets them, by the objects' Blender names.
+const LOOK: &str = "
+[[object]]
+name = \"Ground\"
+[[object.layer]]
+[object.layer.set]
+base_color = [0.5, 0.5, 0.5]
+metallic = 0.0
+roughness = 0.6
+specular = 0.5
+[[object]]
+name = \"Ball\"
+[[object.layer]]
+[object.layer.set]
+base_color = [1.0, 0.766, 0.336]
+metallic = 1.0
+roughness = 0.3
+specular = 0.5
+[[object]]
+name = \"Box\"
+[[object.layer]]
+[object.layer.set]
+base_color = [0.8, 0.1, 0.05]
+metallic = 0.0
+roughness = 0.4
+specular = 0.5
+[[object]]
+name = \"Ring\"
+[[object.layer]]
+[object.layer.set]
+base_color = [0.8, 0.1, 0.05]
+metallic = 0.0
+roughness = 0.4
+specular = 0.5
+";
+
+/// The scene saved, Cycles' beauty and the script's g-buffer, made once, in the target's
+/// scratch folder.
+fn renders() -> Option<&'static Path> {
+    static DIR: OnceLock<Option<PathBuf>> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let blender = blender()?;
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("blender-shadows");
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("scene.py"), SCENE).unwrap();
+        std::fs::write(dir.join("look.toml"), LOOK).unwrap();
+        let environment = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/environment/studio.exr");
+        let script = dir.join("scene.py");
+        for (mode, out) in [("blend", "scene.blend"), ("beauty", "beauty.exr")] {
+            let out = dir.join(out);
+            let args = [script.to_str().unwrap(), "--", mode, out.to_str().unwrap(), environment.to_str().unwrap()];
+            run_blender(&blender, &[&["--python"], &args[..]].concat());
+        }
+        let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/blender_gbuffer.py");
+        let out = dir.join("gbuffer.exr");
+        run_blender(
+            &blender,
+            &[
+                dir.join("scene.blend").to_str().unwrap(),
+                "--python",
+                shipped.to_str().unwrap(),
+                "--",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+        );
+        Some(dir)
+    })
+    .as_deref()
+}
+
+/// `lookdev render` of the script's g-buffer with the look, as Blender lit it, in `dir`, with a
+/// cache folder of its own.
+fn render(dir: &Path, out: &str, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "render",
+        "--gbuffer",
+        "gbuffer.exr",
+        "--look",
+        "look.toml",
+        "--env",
+        "builtin:studio",
+        // Blender's equirectangular centre is +X; lookdev's is −Z.
+        "--rotation",
+        "-90",
+        "--spp",
+        "256",
+        "--out",
+        out,
+    ];
+    args.extend_from_slice(extra);
+    Command::new(env!("CARGO_BIN_EXE_lookdev"))
+        .args(&args)
+        .current_dir(dir)
+        .env("LOOKDEV_VALIDATION", "1")
+        .env("XDG_CACHE_HOME", dir.join("cache"))
+        .output()
+        .unwrap()
+}
+
+/// Each object's name and coverage, from the g-buffer's Cryptomatte.
+fn mattes(dir: &Path) -> Vec<(String, Vec<f32>)> {
+    let (channels, text) = read_channels(&dir.join("gbuffer.exr").to_string_lossy());
+    cryptomatte(&channels, &text, "ViewLayer.CryptoObject", WIDTH * HEIGHT)
+}
+
+/// Per object, by Cryptomatte, the pixels inside it: wholly covered by it, as are their eight
+/// neighbours. A pixel at a silhouette or where objects meet holds more than one normal, which
+/// one averaged normal cannot shade as a path tracer does; those are measured apart.
+fn objects(dir: &Path) -> Vec<(String, Vec<usize>)> {
+    mattes(dir)
+        .into_iter()
+        .map(|(name, coverage)| {
+            let whole = |x: usize, y: usize| coverage[y * WIDTH + x] == 1.0;
+            let inside = |p: usize| {
+                let (x, y) = (p % WIDTH, p / WIDTH);
+                (1..WIDTH - 1).contains(&x)
+                    && (1..HEIGHT - 1).contains(&y)
+                    && (y - 1..=y + 1).all(|y| (x - 1..=x + 1).all(|x| whole(x, y)))
+            };
+            (name, (0..WIDTH * HEIGHT).filter(|&p| inside(p)).collect())
+        })
+        .collect()
+}
+
+fn luminance(c: [f64; 3]) -> f64 {
+    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+}
+
+/// The bias of lookdev's mean luminance over `pixels` against Cycles', and the mean relative
+/// error of its pixels' luminance.
+fn bias_and_error(ours: &Image, cycles: &Image, pixels: &[usize]) -> (f64, f64) {
+    let at = |image: &Image, p: usize| luminance(["R", "G", "B"].map(|c| image[c][p] as f64));
+    let bias = luminance(mean(ours, "", pixels)) / luminance(mean(cycles, "", pixels)) - 1.0;
+    let relative = pixels.iter().map(|&p| ((at(ours, p) - at(cycles, p)) / at(cycles, p).max(1e-3)).abs());
+    (bias, relative.sum::<f64>() / pixels.len() as f64)
+}
+
+type Image = std::collections::BTreeMap<String, Vec<f32>>;
+
+/// Per object, the bias and mean relative error inside it (see [`objects`]); printed with those
+/// of the pixels at edges (every covered pixel inside no object).
+fn errors(dir: &Path, relit: &str) -> (Vec<(String, f64, f64)>, f64) {
+    let (ours, _) = read_channels(&dir.join(relit).to_string_lossy());
+    let (cycles, _) = read_channels(&dir.join("beauty.exr").to_string_lossy());
+    let objects = objects(dir);
+    let mattes = mattes(dir);
+    let inside: std::collections::BTreeSet<usize> = objects.iter().flat_map(|(_, p)| p.iter().copied()).collect();
+    let covered = |p: usize| mattes.iter().any(|(_, coverage)| coverage[p] > 0.0);
+    let edges: Vec<usize> = (0..WIDTH * HEIGHT).filter(|&p| covered(p) && !inside.contains(&p)).collect();
+    let (bias, relative) = bias_and_error(&ours, &cycles, &edges);
+    eprintln!(
+        "{relit} edges: {} pixels, bias {:+.2}%, mean relative error {:.1}%",
+        edges.len(),
+        bias * 100.0,
+        relative * 100.0
+    );
+    let all: Vec<usize> = (0..WIDTH * HEIGHT).filter(|&p| covered(p)).collect();
+    let (whole, relative) = bias_and_error(&ours, &cycles, &all);
+    eprintln!(
+        "{relit} every covered pixel: {} pixels, bias {:+.2}%, mean relative error {:.1}%",
+        all.len(),
+        whole * 100.0,
+        relative * 100.0
+    );
+    let objects = objects
+        .into_iter()
+        .map(|(name, pixels)| {
+            let (bias, relative) = bias_and_error(&ours, &cycles, &pixels);
+            eprintln!(
+                "{relit} {name}: {} pixels, bias {:+.2}%, mean relative error {:.1}%",
+                pixels.len(),
+                bias * 100.0,
+                relative * 100.0
+            );
+            (name, bias, relative)
+        })
+        .collect();
+    (objects, whole)
+}
+
+#[test]
+fn a_blender_scene_relights_with_its_shadows_like_cycles() {
+    let Some(dir) = renders() else { return };
+    let output = render(dir, "relit.exr", &[]);
+    assert_success(&output);
+    let text = stderr(&output);
+    assert!(text.contains("visibility from gbuffer.occluders.glb, traced over 32² directions"), "{text}");
+    let (shadowed, whole) = errors(dir, "relit.exr");
+    assert!(whole.abs() < 0.04, "the whole image's mean is {:+.1}% off Cycles'", whole * 100.0);
+    assert_eq!(shadowed.len(), 4, "four objects: {shadowed:?}");
+    for (name, bias, relative) in &shadowed {
+        assert!(bias.abs() < 0.03, "{name}: lookdev's mean is {:+.1}% off Cycles' direct light", bias * 100.0);
+        // Both renders' noise at 256 samples is most of it: 5-7% measured.
+        assert!(*relative < 0.08, "{name}: the mean relative error is {:.1}%", relative * 100.0);
+    }
+    // Without the shadows, the open box and the ground are far too bright.
+    assert_success(&render(dir, "unshadowed.exr", &["--no-visibility"]));
+    let (unshadowed, _) = errors(dir, "unshadowed.exr");
+    let worst = unshadowed.iter().map(|(_, bias, _)| *bias).fold(0.0, f64::max);
+    assert!(worst > 0.1, "without shadows the worst bias is only {:+.1}%", worst * 100.0);
+
+    // The trace is cached: the second render says so and gives the same image, bit for bit.
+    let again = render(dir, "again.exr", &[]);
+    assert_success(&again);
+    assert!(stderr(&again).contains("32² directions (cached)"), "{}", stderr(&again));
+    assert_eq!(std::fs::read(dir.join("relit.exr")).unwrap(), std::fs::read(dir.join("again.exr")).unwrap());
+}
+
+#[test]
+fn occluders_that_are_missing_or_not_the_scene_are_one_line_errors() {
+    let Some(dir) = renders() else { return };
+    let work = dir.join("errors");
+    std::fs::create_dir_all(&work).unwrap();
+    // The g-buffer without its occluders beside it.
+    std::fs::copy(dir.join("gbuffer.exr"), work.join("gbuffer.exr")).unwrap();
+    std::fs::write(work.join("look.toml"), LOOK).unwrap();
+    assert_bad_input(&render(&work, "x.exr", &[]), &["gbuffer.exr", "gbuffer.occluders.glb", "--no-visibility"]);
+    assert_success(&render(&work, "x.exr", &["--no-visibility"]));
+    // Another scene's triangles: a cube far from these positions.
+    let mut gltf = Gltf::new();
+    let mesh = gltf.mesh("cube", &[(&cube(1.0), None)]);
+    gltf.node(json!({ "mesh": mesh, "translation": [100.0, 100.0, 100.0] }));
+    let elsewhere = gltf.write_glb(&work, "elsewhere");
+    assert_bad_input(
+        &render(&work, "x.exr", &["--occluders", elsewhere.to_str().unwrap()]),
+        &["gbuffer.exr", "lie on none of the triangles", "elsewhere.glb"],
+    );
+}
