@@ -311,9 +311,19 @@ fn switching_the_visibility_off_shows_the_render_without_it_and_back() {
     let Some(case) = Case::new() else { return };
     case.write(
         "visibility.script",
-        "visibility off\nwait-spp 4\nsave-image off.exr\nvisibility on\nwait-spp 4\nsave-image on.exr\n",
+        &format!(
+            "visibility off\nwait-spp 4\nsave-image off.exr\nvisibility on\nwait-spp 4\nsave-image on.exr\npick {} {}\n",
+            SIZE / 2,
+            SIZE / 2
+        ),
     );
-    assert_success(&case.view(&["--script", "visibility.script", "--exit-after-spp", "4"]));
+    let output = case.view(&["--script", "visibility.script", "--exit-after-spp", "4"]);
+    assert_success(&output);
+    // The inspector gives the pixel's share of sky, as the occlusion AOV does.
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let pick = stdout.lines().find(|l| l.starts_with("lookdev: pixel")).expect("the pick is reported");
+    let occlusion: f32 = pick.split(", occlusion ").nth(1).expect(pick)[..6].parse().unwrap();
+    assert!((0.0..=1.0).contains(&occlusion), "{pick}");
     for (image, flags) in [("off", &["--no-visibility"][..]), ("on", &[][..])] {
         let out = format!("{image}-render.exr");
         let mut args = vec!["render", "--gbuffer", "g.exr", "--spp", "4", "--quiet", "--out", &out];

@@ -394,3 +394,36 @@ fn visibility_too_large_for_the_device_is_a_named_error() {
         }
     }
 }
+
+#[test]
+fn an_object_that_sees_no_sky_is_a_warning_and_a_lint_finding() {
+    let dir = tempfile::tempdir().unwrap();
+    let (blind, open) = (dir.path().join("blind.exr"), dir.path().join("open.exr"));
+    for (path, word) in [(&blind, 0u32), (&open, u32::MAX)] {
+        let mut g = GBuffer::sphere(32, 32);
+        let grid = Grid::new(8).unwrap();
+        g.visibility = Some(visibility::Visibility { grid, words: vec![word; g.pixel_count() * grid.words()] });
+        g.write(path).unwrap();
+    }
+    let look = dir.path().join("look.toml");
+    std::fs::write(&look, "[[object]]\n[[object.layer]]\n").unwrap();
+    let lookdev =
+        |args: &[&str]| std::process::Command::new(env!("CARGO_BIN_EXE_lookdev")).args(args).output().unwrap();
+    let out = dir.path().join("out.png");
+    let rendered =
+        lookdev(&["render", "--gbuffer", blind.to_str().unwrap(), "--spp", "1", "--out", out.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&rendered.stderr).into_owned();
+    assert!(rendered.status.success(), "{text}");
+    assert!(text.contains("blind.exr: object 1 'sphere': 100% of its pixels see the sky along no direction"), "{text}");
+    let linted = lookdev(&["lint", look.to_str().unwrap(), "--gbuffer", blind.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&linted.stdout).into_owned();
+    assert_eq!(linted.status.code(), Some(1), "{stdout}");
+    assert!(stdout.contains("blind.exr: object 1 'sphere': 100% of its pixels"), "{stdout}");
+    // Seeing everything, or read without its visibility, it is clean.
+    for args in
+        [vec!["--gbuffer", open.to_str().unwrap()], vec!["--gbuffer", blind.to_str().unwrap(), "--no-visibility"]]
+    {
+        let linted = lookdev(&[&["lint", look.to_str().unwrap()], &args[..]].concat());
+        assert!(linted.status.success(), "{args:?}: {}", String::from_utf8_lossy(&linted.stdout));
+    }
+}

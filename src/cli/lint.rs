@@ -4,7 +4,8 @@
 //! bound to a map holds a factor, not a value, so the rules that read it are left out; with
 //! `--gbuffer`, the masks and maps the look names must be in the g-buffer (as for a render), and
 //! the bound layers are checked at every covered pixel where they show (making at least half of
-//! the result), with the factor times the map: a finding there gives the share of those pixels. A look
+//! the result), with the factor times the map: a finding there gives the share of those pixels.
+//! Objects most of whose pixels see no sky through the g-buffer's visibility are findings too. A look
 //! that passes prints nothing and exits 0; findings are printed one per line, `FILE:LINE: object,
 //! layer: finding`, and the exit code is 1. A look or g-buffer that cannot be read is an error
 //! (exit 2).
@@ -124,6 +125,10 @@ pub fn run(args: LintArgs) -> Result<()> {
             }
             // The masks and maps must be there, as for a render.
             PackedStacks::pack(&look, covered_object_ids(&read.gbuffer), &read.gbuffer, &read.name)?;
+            for finding in crate::render::scene::blind_objects(&read.gbuffer) {
+                println!("{}: {finding}", read.name.display());
+                count += 1;
+            }
             Some(read.gbuffer)
         }
         false => {

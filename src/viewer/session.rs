@@ -54,6 +54,9 @@ pub struct Inspection {
     pub mask_names: Vec<(String, String)>,
     /// Every g-buffer map channel's value here, by name (`baseColor.R`, `rough`).
     pub maps: Vec<(String, f32)>,
+    /// The cosine-weighted share of the hemisphere that sees the sky, where the g-buffer has
+    /// visibility and the pixel is covered.
+    pub occlusion: Option<f32>,
     /// The stack that shades the pixel, and each of its layers' weight here (`None`: hidden).
     pub stack: Option<ObjectRef>,
     pub layers: Vec<(String, Option<LayerWeight>)>,
@@ -80,6 +83,9 @@ impl std::fmt::Display for Inspection {
         }
         for (name, value) in &self.maps {
             write!(f, ", map.{name} {value:.4}")?;
+        }
+        if let Some(occlusion) = self.occlusion {
+            write!(f, ", occlusion {occlusion:.4}")?;
         }
         if let Some(stack) = self.stack {
             write!(f, "; {stack}:")?;
@@ -756,6 +762,10 @@ impl Session {
             mask_names: self.gbuffer.mask_names.iter().map(|(m, n)| (m.clone(), n.clone())).collect(),
             masks,
             maps,
+            occlusion: self.gbuffer.visibility.as_ref().filter(|_| shaded).map(|visibility| {
+                let normal = glam::Vec3::from(self.gbuffer.normal[index]);
+                crate::visibility::Quadrature::new(visibility.grid).occlusion(visibility.pixel(index), normal)
+            }),
             stack,
             layers,
             params,

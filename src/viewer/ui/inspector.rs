@@ -50,6 +50,13 @@ pub fn show(ui: &mut egui::Ui, session: &Session) {
             ui.label(format!("{value:.3}"));
             ui.end_row();
         }
+        if let Some(occlusion) = pixel.occlusion {
+            ui.label("Sky seen").on_hover_text(
+                "The cosine-weighted share of the hemisphere that sees the environment (the occlusion AOV)",
+            );
+            ui.label(format!("{occlusion:.3}"));
+            ui.end_row();
+        }
         ui.label("Radiance");
         let [r, g, b, a] = pixel.radiance;
         ui.label(format!("{r:.4}, {g:.4}, {b:.4}")).on_hover_text(format!(
