@@ -1,6 +1,7 @@
 //! The estimators of `--sampling` (docs/shading.md#sampling): each one's environment sampling
 //! against its own pdf on the GPU (chi-square), each one's mean against the plain estimator's
-//! on real HDRIs (unbiased), and the command-line switch and `bench --convergence`.
+//! on real HDRIs (unbiased), with visibility and without, and the command-line switch and
+//! `bench --convergence`.
 
 mod common;
 
@@ -97,9 +98,30 @@ fn compensated_environment_sampling_matches_its_pdf() {
 /// and a glossy metal.
 #[test]
 fn every_estimator_is_unbiased() {
+    every_estimator_is_unbiased_with(orthographic_sphere(32));
+}
+
+/// With visibility, blocked directions carry no light in every strategy of every estimator
+/// alike: here a wall of cells (every direction with x + z/2 > 0.2, an occluder to one side of
+/// the sphere, the same for each pixel) that the environment's rotation turns against.
+#[test]
+fn every_estimator_is_unbiased_with_visibility() {
+    let mut gbuffer = orthographic_sphere(32);
+    let grid = lookdev::visibility::Grid::new(16).unwrap();
+    let mut words = vec![0u32; grid.words()];
+    for cell in 0..grid.cells() {
+        let d = grid.centre(cell);
+        if d.x + 0.5 * d.z <= 0.2 {
+            words[cell / 32] |= 1 << (cell % 32);
+        }
+    }
+    let words = words.repeat(gbuffer.pixel_count());
+    gbuffer.visibility = Some(lookdev::visibility::Visibility { grid, words });
+    every_estimator_is_unbiased_with(gbuffer);
+}
+
+fn every_estimator_is_unbiased_with(gbuffer: lookdev::gbuffer::GBuffer) {
     let ctx = common::gpu::context();
-    let size = 32;
-    let gbuffer = orthographic_sphere(size);
     let covered: Vec<usize> = (0..gbuffer.coverage.len()).filter(|&i| gbuffer.coverage[i] == 1.0).collect();
     let n = covered.len() as f64;
     let materials = [

@@ -163,6 +163,18 @@ pub fn run(args: BenchArgs) -> Result<()> {
             100.0 * wall / wall_off
         );
     }
+    // What a sampler that skipped blocked directions could save (docs/decisions.md).
+    let scene = builtin_scene(SIZES[0].0, SIZES[0].1, true)?;
+    let tables = crate::environment::Distribution::for_device(&scene.environment, info.max_image_dimension_2d);
+    let turn = glam::Quat::from_rotation_y(scene.settings.lighting.rotation_degrees.to_radians());
+    if let Some(share) = crate::visibility::blocked_share(&scene.gbuffer, |u| turn * tables.sample(u).0, 8) {
+        println!(
+            "environment samples the visibility blocks at {}x{}: {:.1}% of those above the horizon",
+            SIZES[0].0,
+            SIZES[0].1,
+            100.0 * share
+        );
+    }
     // How far partly covered frames fall behind: the covered rate of the last size against
     // the first's, by wall time (batches as `render` makes them) and by kernel time at 1 spp.
     if let [(first_wall, first_kernel), .., (last_wall, last_kernel)] = rates[..] {
