@@ -427,3 +427,80 @@ fn an_object_that_sees_no_sky_is_a_warning_and_a_lint_finding() {
         assert!(linted.status.success(), "{args:?}: {}", String::from_utf8_lossy(&linted.stdout));
     }
 }
+
+/// Any renderer's file traces its visibility through the scene's triangles given by
+/// `--occluders`: a hand-mapped EXR (normals and positions under names of its own) of the
+/// sphere on the ground seen from above, and the same scene as glTF. The occlusion of the
+/// ground and of the ball against their closed forms, as for the bake.
+#[test]
+fn a_hand_mapped_file_is_traced_through_the_occluders_it_is_given() {
+    use exr::prelude::*;
+    use lookdev::gbuffer::source::Channels;
+    use lookdev::gbuffer::SourceOptions;
+    let dir = tempfile::tempdir().unwrap();
+    let occluders = sphere_on_ground_asset(dir.path());
+    let size = 48usize;
+    let (mut positions, mut normals, mut exact) = (Vec::new(), Vec::new(), Vec::new());
+    for p in 0..size * size {
+        let (x, y) = ((p % size) as f32 + 0.5, (p / size) as f32 + 0.5);
+        let (wx, wz) = ((2.0 * x / size as f32 - 1.0) * 3.0, (2.0 * y / size as f32 - 1.0) * 3.0);
+        let r2 = wx * wx + wz * wz;
+        let (position, normal) = if r2 < 1.0 {
+            let position = Vec3::new(wx, 1.0 + (1.0 - r2).sqrt(), wz);
+            (position, position - Vec3::Y)
+        } else {
+            (Vec3::new(wx, 0.0, wz), Vec3::Y)
+        };
+        // The ball's rim, seen edge on, and the ground right under it are left out.
+        exact.push(match r2 {
+            r2 if r2 < 0.95 => Some((1.0 + normal.y) / 2.0),
+            r2 if r2 > 1.1 => Some(ground_occlusion(r2.sqrt())),
+            _ => None,
+        });
+        positions.push(position);
+        normals.push(normal);
+    }
+    let channels: Vec<AnyChannel<FlatSamples>> = [("Pw", &positions), ("Nw", &normals)]
+        .into_iter()
+        .flat_map(|(layer, vectors)| {
+            ["X", "Y", "Z"].into_iter().enumerate().map(move |(k, c)| {
+                AnyChannel::new(
+                    Text::from(format!("{layer}.{c}").as_str()),
+                    FlatSamples::F32(vectors.iter().map(|v| v[k]).collect()),
+                )
+            })
+        })
+        .collect();
+    let path = dir.path().join("mapped.exr");
+    let layer = Layer::new(
+        (size, size),
+        LayerAttributes::default(),
+        Encoding::FAST_LOSSLESS,
+        AnyChannels::sort(channels.into()),
+    );
+    Image::from_layer(layer).write().to_file(&path).unwrap();
+
+    let options = SourceOptions {
+        channels: Channels { normal: Some("Nw".into()), position: Some("Pw".into()), ..Channels::default() },
+        camera_position: Some(Vec3::new(0.0, 50.0, 0.0)),
+        occluders: Some(occluders.clone()),
+        ..SourceOptions::default()
+    };
+    let read = GBuffer::read_with(&path, &options).unwrap();
+    let visibility = read.gbuffer.visibility.as_ref().expect("traced through the occluders");
+    assert_eq!(visibility.grid, Grid::new(visibility::DEFAULT_SIDE).unwrap());
+    assert!(read.detected.summary(&path).contains("visibility from sphere-on-ground.glb, traced over 32² directions"));
+    let occlusion = visibility::occlusion(&read.gbuffer);
+    let worst = (0..size * size).filter_map(|p| exact[p].map(|e: f32| (occlusion[p] - e).abs())).fold(0.0f32, f32::max);
+    eprintln!("hand-mapped, traced through glTF occluders: worst occlusion error {worst:.4}");
+    assert!(worst < 0.01, "{worst}");
+
+    // Without positions (lookdev's own file has none) there is nothing to trace from.
+    let own = dir.path().join("own.exr");
+    GBuffer::sphere(8, 8).write(&own).unwrap();
+    let error = GBuffer::read_with(&own, &SourceOptions { occluders: Some(occluders), ..SourceOptions::default() })
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(error.contains("own.exr") && error.contains("no P or Position layer"), "{error}");
+}
