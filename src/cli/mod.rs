@@ -13,7 +13,7 @@ mod inputs;
 mod lint;
 mod look;
 mod presets;
-mod progress;
+pub(crate) mod progress;
 mod render;
 mod turntable;
 mod view;

@@ -26,6 +26,14 @@ impl Progress {
         Progress { total, label: label.into(), unit, quiet, start: Instant::now(), bar: None }
     }
 
+    /// Sets the total, for work whose size is known only once it starts.
+    pub fn set_total(&mut self, total: u64) {
+        self.total = total;
+        if let Some(bar) = &self.bar {
+            bar.set_length(total);
+        }
+    }
+
     /// Reports `done` of `total`; the bar appears once the work has run for a second.
     pub fn update(&mut self, done: u64) {
         if self.quiet {

@@ -39,6 +39,15 @@ impl GBuffer {
     /// file the header's note names) and no stored visibility gets one traced through them
     /// ([`crate::visibility::occluders`]).
     pub fn read_with(path: &Path, options: &SourceOptions) -> Result<Read> {
+        GBuffer::read_reporting(path, options, &|_, _| {})
+    }
+
+    /// [`GBuffer::read_with`], calling `progress(done, total)` while it traces visibility.
+    pub fn read_reporting(
+        path: &Path,
+        options: &SourceOptions,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<Read> {
         let (mut read, surfaces) = decode(&input::read(path, Kind::GBuffer)?, path, options)?;
         if options.no_visibility {
             read.gbuffer.visibility = None;
@@ -67,7 +76,8 @@ impl GBuffer {
             ));
         };
         let grid = Grid::new(occluders.side.unwrap_or(DEFAULT_SIDE)).map_err(Error::input)?;
-        let traced = crate::visibility::occluders::trace_positions(&read.gbuffer, path, &positions, &occluders, grid)?;
+        let traced =
+            crate::visibility::occluders::trace_positions(&read.gbuffer, path, &positions, &occluders, grid, progress)?;
         read.gbuffer.visibility = Some(traced.visibility);
         read.detected.from.push(("visibility".into(), traced.how));
         read.warnings.extend(traced.warnings);

@@ -208,7 +208,23 @@ pub fn read_gbuffer(spec: &GBufferSpec, look: &mut Look, quiet: bool) -> Result<
     let (gbuffer, name) = match file {
         Some(path) => {
             let options = SourceOptions { no_visibility: spec.ignore_visibility, ..spec.source.clone() };
-            let read = GBuffer::read_with(&path, &options.over(&look.gbuffer.source))?;
+            // Tracing a production render's shadows can take minutes: a bar shows it.
+            let bar = std::sync::Mutex::new(crate::cli::progress::Progress::counting(
+                0,
+                format!("tracing the shadows of {}", path.display()),
+                "pixel runs",
+                quiet,
+            ));
+            let progress = |done: usize, total: usize| {
+                if let Ok(mut bar) = bar.lock() {
+                    bar.set_total(total as u64);
+                    bar.update(done as u64);
+                }
+            };
+            let read = GBuffer::read_reporting(&path, &options.over(&look.gbuffer.source), &progress)?;
+            if let Ok(bar) = bar.into_inner() {
+                bar.finish();
+            }
             if !quiet && read.detected.source != Source::Lookdev {
                 eprintln!("lookdev: {}", crate::printable(&read.detected.summary(&path)));
             }

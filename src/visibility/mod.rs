@@ -15,7 +15,7 @@ pub mod occluders;
 mod trace;
 
 pub use mesh::Mesh;
-pub use trace::{trace, Occluder, SurfacePoint};
+pub use trace::{trace, trace_reporting, Occluder, SurfacePoint};
 
 use glam::{Vec2, Vec3};
 

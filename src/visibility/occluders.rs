@@ -10,7 +10,7 @@
 //! position floats between two surfaces) is traced from where it is, its shading normal standing
 //! in for the geometric one.
 
-use super::{trace, Grid, Mesh, SurfacePoint, Visibility};
+use super::{trace_reporting, Grid, Mesh, SurfacePoint, Visibility};
 use crate::asset::{geometry, Asset, Texels};
 use crate::cache::{self, Entry};
 use crate::gbuffer::source::occluders::Occluders;
@@ -43,13 +43,15 @@ pub struct Traced {
 }
 
 /// The visibility of `gbuffer` (read from `gbuffer_path`), traced over `grid` from its
-/// `positions` through `occluders`, or loaded from the cache.
+/// `positions` through `occluders`, or loaded from the cache. A trace calls `progress(done,
+/// total)` as it goes.
 pub fn trace_positions(
     gbuffer: &GBuffer,
     gbuffer_path: &Path,
     positions: &[Vec3],
     occluders: &Occluders,
     grid: Grid,
+    progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<Traced> {
     let file = &occluders.file;
     if !file.is_file() {
@@ -99,7 +101,7 @@ pub fn trace_positions(
             file.display()
         ));
     }
-    let visibility = trace(grid, &points, &mesh, OFFSET * diameter);
+    let visibility = trace_reporting(grid, &points, &mesh, OFFSET * diameter, progress);
     if let Some(path) = &path {
         let payload: Vec<u8> = visibility.words.iter().flat_map(|w| w.to_le_bytes()).collect();
         if payload.len() as u64 <= CACHED.max_payload {

@@ -50,18 +50,29 @@ pub struct SurfacePoint {
 /// moved `offset` along its geometric normal. Pixels without a point (the background) see
 /// everything. The pixels are split between the machine's cores.
 pub fn trace(grid: Grid, points: &[Option<SurfacePoint>], occluder: &dyn Occluder, offset: f32) -> Visibility {
+    trace_reporting(grid, points, occluder, offset, &|_, _| {})
+}
+
+/// [`trace`], calling `progress(done, total)` from the tracing threads as runs of pixels finish.
+pub fn trace_reporting(
+    grid: Grid,
+    points: &[Option<SurfacePoint>],
+    occluder: &dyn Occluder,
+    offset: f32,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Visibility {
     let words = grid.words();
     let mut bits = vec![0u32; points.len() * words];
     let quadrature = Quadrature::new(grid);
     // Runs of pixels, taken in turn by the threads as they finish: the pixels' costs differ by
     // far more than a split by rows would even out.
     let runs: Vec<Run> = points.chunks(RUN).zip(bits.chunks_mut(RUN * words)).map(Mutex::new).collect();
-    let next = AtomicUsize::new(0);
+    let (next, finished) = (AtomicUsize::new(0), AtomicUsize::new(0));
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     std::thread::scope(|scope| {
         for _ in 0..threads {
             let tracer = Tracer { quadrature: &quadrature, occluder, offset };
-            let (runs, next) = (&runs, &next);
+            let (runs, next, finished) = (&runs, &next, &finished);
             scope.spawn(move || {
                 let mut cells = Vec::new();
                 while let Some(run) = runs.get(next.fetch_add(1, Ordering::Relaxed)) {
@@ -73,6 +84,7 @@ pub fn trace(grid: Grid, points: &[Option<SurfacePoint>], occluder: &dyn Occlude
                             None => pixel.fill(u32::MAX),
                         }
                     }
+                    progress(finished.fetch_add(1, Ordering::Relaxed) + 1, runs.len());
                 }
             });
         }
