@@ -15,7 +15,7 @@
 
 mod common;
 
-use common::blender::{blender, cryptomatte, mean, read_channels, run_blender};
+use common::blender::{blender, cryptomatte, look_by_names, mean, read_channels, run_blender, scene_script, GOLD, RED};
 use common::cli::{assert_bad_input, assert_success, stderr};
 use lookdev::gbuffer::{GBuffer, SourceOptions};
 use std::path::{Path, PathBuf};
@@ -25,31 +25,9 @@ use std::sync::OnceLock;
 const WIDTH: usize = 160;
 const HEIGHT: usize = 120;
 
-/// Builds the scene and, by mode, saves it (`blend`), renders Blender's plain passes
-/// (`plain`), or renders the direct-light beauty (`beauty`).
+/// The scene's objects, each invisible to shadow, diffuse and glossy rays, and its camera
+/// ([`scene_script`] adds the rest).
 const SCENE: &str = r#"
-import bpy, sys
-mode, out, environment = sys.argv[sys.argv.index("--") + 1:]
-bpy.ops.wm.read_factory_settings(use_empty=True)
-scene = bpy.context.scene
-scene.render.engine = 'CYCLES'
-scene.cycles.device = 'CPU'
-scene.cycles.use_denoising = False
-scene.cycles.use_adaptive_sampling = False
-scene.render.resolution_x, scene.render.resolution_y = 160, 120
-scene.render.resolution_percentage = 100
-def material(name, color, metallic, roughness):
-    m = bpy.data.materials.new(name)
-    m.use_nodes = True
-    p = m.node_tree.nodes["Principled BSDF"]
-    p.distribution = 'GGX'
-    p.inputs["Base Color"].default_value = (*color, 1)
-    p.inputs["Metallic"].default_value = metallic
-    p.inputs["Roughness"].default_value = roughness
-    p.inputs["Specular"].default_value = 0.5
-    return m
-red = material("Red Paint", (0.8, 0.1, 0.05), 0.0, 0.4)
-gold = material("Gold", (1.0, 0.766, 0.336), 1.0, 0.3)
 def add(kind, name, location, size, mat):
     if kind == "sphere":
         bpy.ops.mesh.primitive_uv_sphere_add(radius=size, location=location, segments=64, ring_count=32)
@@ -72,36 +50,7 @@ scene.collection.objects.link(camera)
 scene.camera = camera
 camera.location = (0.4, -7.5, 2.8)
 camera.rotation_euler = (1.22, 0, 0.05)
-world = bpy.data.worlds.new("World")
-scene.world = world
-world.use_nodes = True
-texture = world.node_tree.nodes.new("ShaderNodeTexEnvironment")
-texture.image = bpy.data.images.load(environment)
-world.node_tree.links.new(texture.outputs["Color"], world.node_tree.nodes["Background"].inputs["Color"])
-layer = scene.view_layers[0]
-layer.cycles.denoising_store_passes = False
-settings = scene.render.image_settings
-scene.render.filepath = out
-if mode == "blend":
-    bpy.ops.wm.save_as_mainfile(filepath=out)
-elif mode == "plain":
-    scene.cycles.samples = 16
-    layer.use_pass_normal = layer.use_pass_position = layer.use_pass_z = True
-    layer.use_pass_cryptomatte_object = layer.use_pass_cryptomatte_material = layer.use_pass_cryptomatte_asset = True
-    settings.file_format = 'OPEN_EXR_MULTILAYER'
-    settings.color_depth = '32'
-    bpy.ops.render.render(write_still=True)
-elif mode == "beauty":
-    scene.cycles.samples = 256
-    scene.cycles.max_bounces = 0
-    settings.file_format = 'OPEN_EXR'
-    settings.color_depth = '32'
-    bpy.ops.render.render(write_still=True)
 "#;
-
-/// The materials as lookdev sets them, by their Blender names.
-const RED: &str = "base_color = [0.8, 0.1, 0.05]\nmetallic = 0.0\nroughness = 0.4\nspecular = 0.5\n";
-const GOLD: &str = "base_color = [1.0, 0.766, 0.336]\nmetallic = 1.0\nroughness = 0.3\nspecular = 0.5\n";
 
 /// Blender's camera, in its own (Z-up) coordinates, for the plain render, which records none.
 const CAMERA: &str = "0.4,-7.5,2.8";
@@ -126,7 +75,7 @@ impl Renders {
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         let d = dir.as_path();
-        std::fs::write(d.join("scene.py"), SCENE).unwrap();
+        std::fs::write(d.join("scene.py"), scene_script(SCENE)).unwrap();
         let environment = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/environment/studio.exr");
         let env = environment.to_str().unwrap();
         let script = d.join("scene.py").to_string_lossy().into_owned();
@@ -215,11 +164,7 @@ fn blender_renders_relight_like_cycles_and_decode_like_the_specification() {
     assert_eq!(g.object_names.get(&2).map(String::as_str), Some("Sphere.001"));
 
     // Looks by object names and by material mattes.
-    let by_names = format!(
-        "[[object]]\nname = \"Sphere\"\n[[object.layer]]\n[object.layer.set]\n{RED}\n\
-         [[object]]\nname = \"Sphere.001\"\n[[object.layer]]\n[object.layer.set]\n{GOLD}\n\
-         [[object]]\nname = \"Cube\"\n[[object.layer]]\n[object.layer.set]\n{RED}\n"
-    );
+    let by_names = look_by_names(&[("Sphere", RED), ("Sphere.001", GOLD), ("Cube", RED)]);
     let by_mattes = format!(
         "[[object]]\n[[object.layer]]\n[object.layer.set]\n{RED}\n[[object.layer]]\nmask = \"Gold\"\n[object.layer.set]\n{GOLD}\n"
     );

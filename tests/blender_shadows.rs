@@ -7,7 +7,9 @@
 
 mod common;
 
-use common::blender::{blender, cryptomatte, mean, read_channels, run_blender};
+use common::blender::{
+    blender, cryptomatte, look_by_names, mean, read_channels, run_blender, scene_script, GOLD, GREY, RED,
+};
 use common::cli::{assert_bad_input, assert_success, stderr};
 use common::gltf::{cube, Gltf};
 use serde_json::json;
@@ -18,31 +20,8 @@ use std::sync::OnceLock;
 const WIDTH: usize = 160;
 const HEIGHT: usize = 120;
 
-/// Builds the scene and, by mode, saves it (`blend`) or renders Cycles' direct light with
-/// shadows (`beauty`).
+/// The scene's objects and camera ([`scene_script`] adds the rest).
 const SCENE: &str = r#"
-import bpy, bmesh, sys
-mode, out, environment = sys.argv[sys.argv.index("--") + 1:]
-bpy.ops.wm.read_factory_settings(use_empty=True)
-scene = bpy.context.scene
-scene.render.engine = 'CYCLES'
-scene.cycles.device = 'CPU'
-scene.cycles.use_denoising = False
-scene.cycles.use_adaptive_sampling = False
-scene.render.resolution_x, scene.render.resolution_y = 160, 120
-scene.render.resolution_percentage = 100
-def material(name, color, metallic, roughness):
-    m = bpy.data.materials.new(name)
-    m.use_nodes = True
-    p = m.node_tree.nodes["Principled BSDF"]
-    p.distribution = 'GGX'
-    p.inputs["Base Color"].default_value = (*color, 1)
-    p.inputs["Metallic"].default_value = metallic
-    p.inputs["Roughness"].default_value = roughness
-    p.inputs["Specular"].default_value = 0.5
-    return m
-red = material("Red Paint", (0.8, 0.1, 0.05), 0.0, 0.4)
-gold = material("Gold", (1.0, 0.766, 0.336), 1.0, 0.3)
 grey = material("Grey", (0.5, 0.5, 0.5), 0.0, 0.6)
 def finish(name, mat):
     o = bpy.context.object
@@ -69,61 +48,12 @@ scene.collection.objects.link(camera)
 scene.camera = camera
 camera.location = (0.3, -6.5, 4.2)
 camera.rotation_euler = (0.98, 0, 0.04)
-world = bpy.data.worlds.new("World")
-scene.world = world
-world.use_nodes = True
-texture = world.node_tree.nodes.new("ShaderNodeTexEnvironment")
-texture.image = bpy.data.images.load(environment)
-world.node_tree.links.new(texture.outputs["Color"], world.node_tree.nodes["Background"].inputs["Color"])
-layer = scene.view_layers[0]
-layer.cycles.denoising_store_passes = False
-settings = scene.render.image_settings
-scene.render.filepath = out
-if mode == "blend":
-    bpy.ops.wm.save_as_mainfile(filepath=out)
-elif mode == "beauty":
-    scene.cycles.samples = 256
-    scene.cycles.max_bounces = 0
-    settings.file_format = 'OPEN_EXR'
-    settings.color_depth = '32'
-    bpy.ops.render.render(write_still=True)
 "#;
 
 /// The materials as lookdev sets them, by the objects' Blender names.
-const LOOK: &str = "
-[[object]]
-name = \"Ground\"
-[[object.layer]]
-[object.layer.set]
-base_color = [0.5, 0.5, 0.5]
-metallic = 0.0
-roughness = 0.6
-specular = 0.5
-[[object]]
-name = \"Ball\"
-[[object.layer]]
-[object.layer.set]
-base_color = [1.0, 0.766, 0.336]
-metallic = 1.0
-roughness = 0.3
-specular = 0.5
-[[object]]
-name = \"Box\"
-[[object.layer]]
-[object.layer.set]
-base_color = [0.8, 0.1, 0.05]
-metallic = 0.0
-roughness = 0.4
-specular = 0.5
-[[object]]
-name = \"Ring\"
-[[object.layer]]
-[object.layer.set]
-base_color = [0.8, 0.1, 0.05]
-metallic = 0.0
-roughness = 0.4
-specular = 0.5
-";
+fn look() -> String {
+    look_by_names(&[("Ground", GREY), ("Ball", GOLD), ("Box", RED), ("Ring", RED)])
+}
 
 /// The scene saved, Cycles' beauty and the script's g-buffer, made once, in the target's
 /// scratch folder.
@@ -134,8 +64,8 @@ fn renders() -> Option<&'static Path> {
         let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("blender-shadows");
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
-        std::fs::write(dir.join("scene.py"), SCENE).unwrap();
-        std::fs::write(dir.join("look.toml"), LOOK).unwrap();
+        std::fs::write(dir.join("scene.py"), scene_script(SCENE)).unwrap();
+        std::fs::write(dir.join("look.toml"), look()).unwrap();
         let environment = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/environment/studio.exr");
         let script = dir.join("scene.py");
         for (mode, out) in [("blend", "scene.blend"), ("beauty", "beauty.exr")] {
@@ -306,7 +236,7 @@ fn occluders_that_are_missing_or_not_the_scene_are_one_line_errors() {
     std::fs::create_dir_all(&work).unwrap();
     // The g-buffer without its occluders beside it.
     std::fs::copy(dir.join("gbuffer.exr"), work.join("gbuffer.exr")).unwrap();
-    std::fs::write(work.join("look.toml"), LOOK).unwrap();
+    std::fs::write(work.join("look.toml"), look()).unwrap();
     assert_bad_input(&render(&work, "x.exr", &[]), &["gbuffer.exr", "gbuffer.occluders.glb", "--no-visibility"]);
     assert_success(&render(&work, "x.exr", &["--no-visibility"]));
     // Another scene's triangles: a cube far from these positions.
