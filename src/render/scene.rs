@@ -68,11 +68,8 @@ impl Scene {
         prepare_look(&mut look, &spec.sets)?;
         let settings = Settings::resolve(&look, &spec.overrides)?;
         let environment = load_environment(settings.environment.as_ref(), &spec.env_options)?;
-        let ReadGBuffer { mut gbuffer, name: gbuffer_name, claims } =
-            read_gbuffer(&spec.gbuffer, &mut look, spec.quiet)?;
-        if spec.gbuffer.ignore_visibility {
-            gbuffer.visibility = None;
-        }
+        // read_gbuffer leaves the visibility out under --no-visibility, of a file and of the ball.
+        let ReadGBuffer { gbuffer, name: gbuffer_name, claims } = read_gbuffer(&spec.gbuffer, &mut look, spec.quiet)?;
         claims.into_iter().for_each(crate::warn);
         let covered = covered_object_ids(&gbuffer);
         let stacks = PackedStacks::pack(&look, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
