@@ -36,6 +36,10 @@ layout(constant_id = 8) const uint PRODUCT_SAMPLING = 0u;
 // carry light only along directions the pixel's surface sees the environment. 0 without
 // visibility: every direction above the horizon is seen, and the image bound is a placeholder.
 layout(constant_id = 11) const uint VISIBILITY_SIDE = 0u;
+// Whether some object catches shadows (docs/formats.md#shadow-catchers): a catcher's pixels
+// (flagged in the resolved material) also sum their estimates as if the visibility blocked
+// nothing, into `unshadowed`, for finalize.comp to divide. 0: that image is a placeholder.
+layout(constant_id = 12) const uint SHADOW_CATCHER = 0u;
 
 #include "common.glsl"
 #include "material.glsl"
@@ -48,12 +52,14 @@ layout(constant_id = 11) const uint VISIBILITY_SIDE = 0u;
 
 // Layer 0: N.xyz and coverage A; layer 1: V.xyz; layer 2: T.xyz (unit, orthogonal to N).
 layout(set = 0, binding = 0, rgba32f) uniform readonly image2DArray surface;
-// The resolved material: four layers as material.glsl unpacks them, then emission (rgb).
+// The resolved material: four layers as material.glsl unpacks them, then emission (rgb) and
+// whether the pixel's object catches shadows (a: 1 or 0).
 layout(set = 0, binding = 1, rgba32f) uniform readonly image2DArray resolved;
 // Covered pixels: the running sum of the radiance estimates (rgb) and their number (a).
 // Uncovered pixels are never written.
 layout(set = 0, binding = 2, rgba32f) uniform image2D accumulation;
-// The environment behind each pixel (rgb), written by the first pass of an accumulation.
+// The environment behind each pixel (rgb) and whether it catches shadows (a: 1 or 0), written
+// once per lighting and stacks. A catcher's pixels have it wherever the background is shown.
 layout(set = 0, binding = 3, rgba32f) uniform writeonly image2D background;
 // With LOBE_AOVS, the running sums of each lobe's share: layers diffuse (with subsurface),
 // specular, clearcoat and sheen, all weighted as they enter the total.
@@ -73,6 +79,9 @@ layout(set = 0, binding = 9, std430) buffer Active {
 // that a pixel's words share cache lines; VISIBILITY_ROW texels a row.
 layout(set = 0, binding = 10, rgba32ui) uniform readonly uimage2D visibility;
 const uint VISIBILITY_ROW = 4096u;
+// With SHADOW_CATCHER, every covered pixel's running sum of its estimates with nothing blocked
+// (rgb): a catcher's own, any other pixel's the same as its accumulation.
+layout(set = 0, binding = 11, rgba32f) uniform image2D unshadowed;
 // Texels of visibility a pixel has.
 const uint VISIBILITY_TEXELS = (VISIBILITY_SIDE * VISIBILITY_SIDE + 127u) / 128u;
 
@@ -149,18 +158,26 @@ vec4 environment_texel(uint cluster, vec2 uv) {
 }
 
 // One MIS estimate of reflected radiance toward the view; the frame (fx, fy, fn) is the shading
-// frame expressed in environment space, so no per-sample rotation is needed.
-vec3 estimate(uint visibility_first, Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, uint cluster, vec2 u_env, vec2 u_brdf) {
+// frame expressed in environment space, so no per-sample rotation is needed. For a shadow
+// catcher, `open` is the same estimate with every direction seen (else 0).
+vec3 estimate(uint visibility_first, bool catcher, Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, uint cluster,
+              vec2 u_env, vec2 u_brdf, out vec3 open) {
     vec3 result = vec3(0.0);
+    open = vec3(0.0);
 
     vec4 texel;
     vec3 d = sample_environment(cluster, u_env, texel);
     vec3 l = vec3(dot(d, fx), dot(d, fy), dot(d, fn));
-    if (l.z > 0.0 && texel.a > 0.0 && seen(visibility_first, d)) {
-        HalfVector hv = make_half_vector(s, l, view.v);
-        vec3 f = disney_brdf(s, view, l, hv);
-        float pdf_brdf = brdf_pdf(choice, view, l, hv);
-        result += f * (l.z * mis_weight_over_pdf(texel.a, pdf_brdf)) * texel.rgb;
+    if (l.z > 0.0 && texel.a > 0.0) {
+        bool lit = seen(visibility_first, d);
+        if (lit || catcher) {
+            HalfVector hv = make_half_vector(s, l, view.v);
+            vec3 f = disney_brdf(s, view, l, hv);
+            float pdf_brdf = brdf_pdf(choice, view, l, hv);
+            vec3 light = f * (l.z * mis_weight_over_pdf(texel.a, pdf_brdf)) * texel.rgb;
+            result += lit ? light : vec3(0.0);
+            open += light;
+        }
     }
 
     l = sample_brdf(s, choice, view, u_brdf);
@@ -168,38 +185,57 @@ vec3 estimate(uint visibility_first, Lobes s, LobeChoice choice, View view, vec3
         HalfVector hv = make_half_vector(s, l, view.v);
         float pdf_brdf = brdf_pdf(choice, view, l, hv);
         d = normalize(l.x * fx + l.y * fy + l.z * fn);
-        if (pdf_brdf > 0.0 && seen(visibility_first, d)) {
+        bool lit = pdf_brdf > 0.0 && seen(visibility_first, d);
+        if (lit || (catcher && pdf_brdf > 0.0)) {
             texel = environment_texel(cluster, env_direction_to_uv(d));
             vec3 f = disney_brdf(s, view, l, hv);
-            result += f * (l.z * mis_weight_over_pdf(pdf_brdf, texel.a)) * texel.rgb;
+            vec3 light = f * (l.z * mis_weight_over_pdf(pdf_brdf, texel.a)) * texel.rgb;
+            result += lit ? light : vec3(0.0);
+            open += light;
         }
     }
+    open *= pass.intensity;
     return result * pass.intensity;
 }
 
+// Adds one sample's light, whose BRDF lobes are b and MIS weight over pdf w, to `result` and
+// each lobe's share to `shares`.
+void add_lobes(Lobes s, BrdfLobes b, float w, vec3 radiance, inout vec3 result, inout vec3 shares[4]) {
+    float diffuse_weight = 1.0 - s.metallic;
+    result += lobes_total(s, b) * w * radiance;
+    shares[LOBE_DIFFUSE] += b.diffuse * diffuse_weight * w * radiance;
+    shares[LOBE_SPECULAR] += b.specular * w * radiance;
+    shares[LOBE_CLEARCOAT] += vec3(b.clearcoat) * w * radiance;
+    shares[LOBE_SHEEN] += b.sheen * diffuse_weight * w * radiance;
+}
+
 // The same estimate as `estimate`, bit for bit, with each lobe's share of it beside: the
-// lobes' sum is the total up to float rounding.
-vec3 estimate_lobes(uint visibility_first, Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, uint cluster, vec2 u_env, vec2 u_brdf,
-                    out vec3 shares[4]) {
+// lobes' sum is the total up to float rounding. A catcher's shares are those of the total.
+vec3 estimate_lobes(uint visibility_first, bool catcher, Lobes s, LobeChoice choice, View view, vec3 fx, vec3 fy, vec3 fn, uint cluster,
+                    vec2 u_env, vec2 u_brdf, out vec3 open, out vec3 shares[4]) {
     vec3 result = vec3(0.0);
+    open = vec3(0.0);
     for (int k = 0; k < 4; k++) {
         shares[k] = vec3(0.0);
     }
-    float diffuse_weight = 1.0 - s.metallic;
 
     vec4 texel;
     vec3 d = sample_environment(cluster, u_env, texel);
     vec3 l = vec3(dot(d, fx), dot(d, fy), dot(d, fn));
-    if (l.z > 0.0 && texel.a > 0.0 && seen(visibility_first, d)) {
-        HalfVector hv = make_half_vector(s, l, view.v);
-        BrdfLobes b = disney_lobes(s, view, l, hv);
-        float pdf_brdf = brdf_pdf(choice, view, l, hv);
-        float w = l.z * mis_weight_over_pdf(texel.a, pdf_brdf);
-        result += lobes_total(s, b) * w * texel.rgb;
-        shares[LOBE_DIFFUSE] += b.diffuse * diffuse_weight * w * texel.rgb;
-        shares[LOBE_SPECULAR] += b.specular * w * texel.rgb;
-        shares[LOBE_CLEARCOAT] += vec3(b.clearcoat) * w * texel.rgb;
-        shares[LOBE_SHEEN] += b.sheen * diffuse_weight * w * texel.rgb;
+    if (l.z > 0.0 && texel.a > 0.0) {
+        bool lit = seen(visibility_first, d);
+        if (lit || catcher) {
+            HalfVector hv = make_half_vector(s, l, view.v);
+            BrdfLobes b = disney_lobes(s, view, l, hv);
+            float pdf_brdf = brdf_pdf(choice, view, l, hv);
+            float w = l.z * mis_weight_over_pdf(texel.a, pdf_brdf);
+            if (lit) {
+                add_lobes(s, b, w, texel.rgb, result, shares);
+            }
+            if (catcher) {
+                open += lobes_total(s, b) * w * texel.rgb;
+            }
+        }
     }
 
     l = sample_brdf(s, choice, view, u_brdf);
@@ -207,32 +243,41 @@ vec3 estimate_lobes(uint visibility_first, Lobes s, LobeChoice choice, View view
         HalfVector hv = make_half_vector(s, l, view.v);
         float pdf_brdf = brdf_pdf(choice, view, l, hv);
         d = normalize(l.x * fx + l.y * fy + l.z * fn);
-        if (pdf_brdf > 0.0 && seen(visibility_first, d)) {
+        bool lit = pdf_brdf > 0.0 && seen(visibility_first, d);
+        if (lit || (catcher && pdf_brdf > 0.0)) {
             texel = environment_texel(cluster, env_direction_to_uv(d));
             BrdfLobes b = disney_lobes(s, view, l, hv);
             float w = l.z * mis_weight_over_pdf(pdf_brdf, texel.a);
-            result += lobes_total(s, b) * w * texel.rgb;
-            shares[LOBE_DIFFUSE] += b.diffuse * diffuse_weight * w * texel.rgb;
-            shares[LOBE_SPECULAR] += b.specular * w * texel.rgb;
-            shares[LOBE_CLEARCOAT] += vec3(b.clearcoat) * w * texel.rgb;
-            shares[LOBE_SHEEN] += b.sheen * diffuse_weight * w * texel.rgb;
+            if (lit) {
+                add_lobes(s, b, w, texel.rgb, result, shares);
+            }
+            if (catcher) {
+                open += lobes_total(s, b) * w * texel.rgb;
+            }
         }
     }
     for (int k = 0; k < 4; k++) {
         shares[k] *= pass.intensity;
     }
+    open *= pass.intensity;
     return result * pass.intensity;
 }
 
-// The environment behind `pixel`, where the surface does not cover it all.
+// Whether the pixel's object catches shadows (0 on uncovered pixels, whose material is clear).
+bool catches_shadows(ivec2 pixel) {
+    return SHADOW_CATCHER != 0u && imageLoad(resolved, ivec3(pixel, 4)).a != 0.0;
+}
+
+// The environment behind `pixel`, where the surface does not cover it all or catches shadows.
 void write_background(ivec2 pixel) {
     float coverage = imageLoad(surface, ivec3(pixel, 0)).w;
+    bool catcher = catches_shadows(pixel);
     vec3 behind = vec3(0.0);
-    if (pass.show_background != 0u && coverage < 1.0) {
+    if (pass.show_background != 0u && (coverage < 1.0 || catcher)) {
         vec3 view = imageLoad(surface, ivec3(pixel, 1)).xyz;
         behind = pass.intensity * env_background(env_direction_to_uv(to_environment(-view)));
     }
-    imageStore(background, pixel, vec4(behind, 0.0));
+    imageStore(background, pixel, vec4(behind, catcher ? 1.0 : 0.0));
 }
 
 // Whether the stop test runs after `n` samples: at min_samples, then at each power of two,
@@ -266,6 +311,8 @@ void relight(ivec2 pixel, ivec2 size) {
     vec3 b = cross(n, t);
     vec3 v = vec3(dot(view, t), dot(view, b), dot(view, n));
     vec4 sum = restart ? vec4(0.0) : imageLoad(accumulation, pixel);
+    bool catcher = catches_shadows(pixel);
+    vec3 open_sum = (SHADOW_CATCHER == 0u || restart) ? vec3(0.0) : imageLoad(unshadowed, pixel).rgb;
     float squares = moment.r;
     vec3 lobes[4];
     for (int k = 0; k < 4; k++) {
@@ -281,6 +328,7 @@ void relight(ivec2 pixel, ivec2 size) {
     if (v.z <= 0.0) {
         for (uint i = pass.first_sample; i < end_sample; i++) {
             sum.rgb += emission;
+            open_sum += emission;
             if (VARIANCE_AOV != 0u) {
                 float y = luminance(emission);
                 squares += y * y;
@@ -308,18 +356,20 @@ void relight(ivec2 pixel, ivec2 size) {
         uint brdf_seed = hash_combine(pixel_seed, 0x425244u);
         for (uint i = pass.first_sample; i < end_sample; i++) {
             vec3 x;
+            vec3 open;
             if (LOBE_AOVS != 0u) {
                 vec3 shares[4];
-                x = emission + estimate_lobes(visibility_first, s, choice, view_terms, fx, fy, fn, cluster, sobol_owen_2d(i, env_seed),
-                                              sobol_owen_2d(i, brdf_seed), shares);
+                x = emission + estimate_lobes(visibility_first, catcher, s, choice, view_terms, fx, fy, fn, cluster,
+                                              sobol_owen_2d(i, env_seed), sobol_owen_2d(i, brdf_seed), open, shares);
                 for (int k = 0; k < 4; k++) {
                     lobes[k] += shares[k];
                 }
             } else {
-                x = emission + estimate(visibility_first, s, choice, view_terms, fx, fy, fn, cluster, sobol_owen_2d(i, env_seed),
-                                        sobol_owen_2d(i, brdf_seed));
+                x = emission + estimate(visibility_first, catcher, s, choice, view_terms, fx, fy, fn, cluster,
+                                        sobol_owen_2d(i, env_seed), sobol_owen_2d(i, brdf_seed), open);
             }
             sum.rgb += x;
+            open_sum += catcher ? emission + open : x;
             if (VARIANCE_AOV != 0u) {
                 float y = luminance(x);
                 squares += y * y;
@@ -341,6 +391,9 @@ void relight(ivec2 pixel, ivec2 size) {
     }
     sum.a = float(end_sample);
     imageStore(accumulation, pixel, sum);
+    if (SHADOW_CATCHER != 0u) {
+        imageStore(unshadowed, pixel, vec4(open_sum, 0.0));
+    }
     if (adaptive && !stopped && pass.source == SOURCE_COVERED) {
         atomicAdd(still_active.rows[pixel.y], 1u);
     }

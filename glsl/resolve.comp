@@ -25,8 +25,8 @@ layout(set = 0, binding = 0, r32ui) uniform readonly uimage2D stack_index;
 // The g-buffer channels the look uses, masks and map channels alike, one layer each.
 layout(set = 0, binding = 1, r32f) uniform readonly image2DArray channels;
 
-// The stacks, one texel each (GpuStack): first layer, layer count. Stack s is texel
-// (s % 1024, s / 1024).
+// The stacks, one texel each (GpuStack): first layer, layer count, whether the object catches
+// shadows. Stack s is texel (s % 1024, s / 1024).
 layout(set = 0, binding = 2, rgba32ui) uniform readonly uimage2D stacks;
 // The layers, eleven texels each (GpuLayer, 176 bytes): the layer's own material (five texels,
 // float bits, as Params::to_gpu lays it out); per value, the layer of `channels` it is
@@ -81,7 +81,7 @@ void main() {
     ivec2 size = imageSize(stack_index);
     ivec2 pixel = unpack_pixel(imageLoad(pixels, list_texel(entry, size.x)).r);
     uint s = imageLoad(stack_index, pixel).r;
-    uvec2 stack = imageLoad(stacks, ivec2(s & 1023u, s >> 10)).xy;  // first layer, layer count
+    uvec3 stack = imageLoad(stacks, ivec2(s & 1023u, s >> 10)).xyz;  // first layer, layer count, catcher
     vec4 p[5];
     layer_material(stack.x, pixel, p);
     for (uint i = 1u; i < stack.y; i++) {
@@ -96,6 +96,8 @@ void main() {
             p[k] = p[k] * (1.0 - w) + q[k] * w;
         }
     }
+    // The emission's unused fourth value says whether the object catches shadows.
+    p[4].a = stack.z != 0u ? 1.0 : 0.0;
     bool differs = false;
     for (int k = 0; k < 5; k++) {
         uvec4 before = floatBitsToUint(imageLoad(resolved, ivec3(pixel, k)));

@@ -71,7 +71,7 @@ fn unknown_keys_name_the_table_and_the_expected_keys() {
     );
     assert_eq!(
         error("[[object]]\nnmae = \"ball\"\n[[object.layer]]\n"),
-        "looks/shot.toml:2: unknown key 'nmae' in [[object]] (expected id, name, layer); did you mean 'name'?"
+        "looks/shot.toml:2: unknown key 'nmae' in [[object]] (expected id, name, shadow_catcher, layer); did you mean 'name'?"
     );
 }
 
@@ -439,6 +439,26 @@ emission = "glow"
     let mut again = Look::parse(&builtin.to_toml(), Path::new(SHOT)).unwrap();
     again.file = None;
     assert_eq!(again, builtin);
+}
+
+#[test]
+fn a_shadow_catcher_is_kept_when_written_back_and_a_wrong_value_is_named() {
+    let text = "[[object]]\nname = \"Ground\"\nshadow_catcher = true\n[[object.layer]]\npreset = \"gold\"\n\
+                [[object]]\nid = 3\nshadow_catcher = false\n[[object.layer]]\npreset = \"wax\"\n";
+    let look = Look::parse(text, Path::new(SHOT)).unwrap();
+    let catchers: Vec<bool> = look.objects.iter().map(|o| o.shadow_catcher).collect();
+    assert_eq!(catchers, [true, false]);
+    let written = look.to_toml();
+    assert_eq!(written.matches("shadow_catcher = true").count(), 1, "{written}");
+    assert!(!written.contains("shadow_catcher = false"), "only the non-default value is written: {written}");
+    assert_eq!(Look::parse(&written, Path::new(SHOT)).unwrap(), look);
+    let mut none = look.clone();
+    none.objects[0].shadow_catcher = false;
+    assert_ne!(none, look, "catching shadows is part of what a stack means");
+
+    let bad = "[[object]]\nid = 1\nshadow_catcher = \"yes\"\n[[object.layer]]\n";
+    let message = Look::parse(bad, Path::new(SHOT)).unwrap_err().to_string();
+    assert!(message.contains(&format!("{SHOT}:3")) && message.contains("shadow_catcher"), "{message}");
 }
 
 #[test]

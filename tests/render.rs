@@ -220,7 +220,7 @@ fn gpu_resolve_matches_the_cpu_blend() {
 #[test]
 fn gpu_relight_matches_the_cpu_mirror() {
     let ctx = common::gpu::context();
-    relight_matches_the_cpu_mirror(&ctx, shaderball_scene(40));
+    relight_matches_the_cpu_mirror(&ctx, shaderball_scene(40), true);
     common::gpu::finish(ctx);
 }
 
@@ -228,13 +228,33 @@ fn gpu_relight_matches_the_cpu_mirror() {
 #[test]
 fn gpu_relight_with_maps_and_emission_matches_the_cpu_mirror() {
     let ctx = common::gpu::context();
-    relight_matches_the_cpu_mirror(&ctx, mapped_shaderball_scene(40));
+    relight_matches_the_cpu_mirror(&ctx, mapped_shaderball_scene(40), true);
     common::gpu::finish(ctx);
 }
 
-fn relight_matches_the_cpu_mirror(ctx: &lookdev::gpu::Context, (gbuffer, look, stacks): (GBuffer, Look, PackedStacks)) {
+/// The same with the pedestal catching the ball's shadow, over the background and without it
+/// (a black shadow with alpha); the `shadow` shares agree too.
+#[test]
+fn gpu_shadow_catcher_matches_the_cpu_mirror() {
+    let ctx = common::gpu::context();
+    let (gbuffer, mut look, _) = shaderball_scene(40);
+    look.objects.iter_mut().find(|o| o.id == Some(2)).unwrap().shadow_catcher = true;
+    let ids = lookdev::render::scene::covered_object_ids(&gbuffer);
+    let stacks = PackedStacks::pack(&look, ids, &gbuffer, Path::new("shader ball")).unwrap();
+    assert_eq!(stacks.shadow_catcher_objects().into_iter().collect::<Vec<_>>(), [2]);
+    for background in [true, false] {
+        relight_matches_the_cpu_mirror(&ctx, (gbuffer.clone(), look.clone(), stacks.clone()), background);
+    }
+    common::gpu::finish(ctx);
+}
+
+fn relight_matches_the_cpu_mirror(
+    ctx: &lookdev::gpu::Context,
+    (gbuffer, look, stacks): (GBuffer, Look, PackedStacks),
+    background: bool,
+) {
     let env = Environment::studio();
-    let lighting = Lighting { rotation_degrees: 37.0, intensity: 1.3, background: true };
+    let lighting = Lighting { rotation_degrees: 37.0, intensity: 1.3, background };
     let seed = 9;
     let spp = 24;
     let mut r = renderer(ctx, &gbuffer, &env, &look, lighting);
@@ -242,15 +262,27 @@ fn relight_matches_the_cpu_mirror(ctx: &lookdev::gpu::Context, (gbuffer, look, s
     r.render_samples(10).unwrap();
     r.render_samples(14).unwrap();
     let radiance = r.read_radiance().unwrap();
+    let shadow = r.read_shadow().unwrap();
     let reference = common::reference_render::Reference::new(&gbuffer, &env, r.sampling(), lighting, seed);
+    let catchers = stacks.shadow_catcher_objects();
     let pixels = gbuffer.pixel_count();
-    let (mut off, mut covered) = (0, 0);
+    let (mut off, mut covered, mut shadowed) = (0, 0, 0);
     for y in 0..gbuffer.height {
         for x in 0..gbuffer.width {
             let i = (y * gbuffer.width + x) as usize;
             let params =
                 if gbuffer.coverage[i] > 0.0 { stacks.resolve_gbuffer_pixel(&gbuffer, i) } else { Params::default() };
-            let cpu = reference.pixel(x, y, &params, spp);
+            let catcher = gbuffer.coverage[i] > 0.0 && catchers.contains(&gbuffer.object_id[i]);
+            let cpu = if catcher {
+                let share = reference.shadow(x, y, &params, spp);
+                let gpu = glam::Vec3::from(shadow[i]);
+                assert!((gpu - share).abs().max_element() < 1e-3, "pixel ({x}, {y}): shadow GPU {gpu} CPU {share}");
+                shadowed += (share.max_element() < 0.8) as usize;
+                reference.catcher_pixel(x, y, &params, spp)
+            } else {
+                assert_eq!(shadow[i], [1.0; 3], "pixel ({x}, {y}) catches no shadow");
+                reference.pixel(x, y, &params, spp)
+            };
             let gpu = glam::Vec4::from(radiance[i]);
             covered += (gbuffer.coverage[i] > 0.0) as usize;
             let error = ((gpu - cpu).abs() / cpu.abs().max(glam::Vec4::splat(0.02))).max_element();
@@ -262,6 +294,8 @@ fn relight_matches_the_cpu_mirror(ctx: &lookdev::gpu::Context, (gbuffer, look, s
         }
     }
     assert!(covered > 300, "{covered}");
+    eprintln!("{shadowed} pixels of a catcher in shadow");
+    assert!(catchers.is_empty() || shadowed > 10, "only {shadowed} pixels of the catcher are in shadow");
     eprintln!("{off} of {pixels} pixels differ by more than 0.1%");
     assert!(off * 400 <= pixels, "{off} of {pixels} pixels differ by more than 0.1%");
 }

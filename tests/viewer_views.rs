@@ -336,3 +336,28 @@ fn switching_the_visibility_off_shows_the_render_without_it_and_back() {
     }
     assert!(case.exr_bits("off.exr") != case.exr_bits("on.exr"), "the shader ball's shadows change its image");
 }
+
+#[test]
+fn a_shadow_catcher_is_toggled_saved_and_undone_as_render_shows_it() {
+    let Some(case) = Case::new() else { return };
+    case.write(
+        "catcher.script",
+        "select 2\ncatcher on\nwait-spp 4\nsave-image caught.exr\nsave-look caught.toml\nundo\nwait-spp 4\n\
+         save-image plain.exr\n",
+    );
+    let output = case.view(&["--script", "catcher.script", "--exit-after-spp", "4"]);
+    assert_success(&output);
+    let saved = std::fs::read_to_string(case.path("caught.toml")).unwrap();
+    assert!(saved.contains("id = 2\nshadow_catcher = true\n"), "{saved}");
+    for (image, look) in [("caught", Some("caught.toml")), ("plain", None)] {
+        let out = format!("{image}-render.exr");
+        let mut args = vec!["render", "--gbuffer", "g.exr", "--spp", "4", "--quiet", "--out", &out];
+        args.extend(look.map(|l| ["--look", l]).iter().flatten());
+        assert_success(&case.command(&args).output().unwrap());
+        assert!(
+            case.exr_bits(&format!("{image}.exr")) == case.exr_bits(&out),
+            "{image}: the render's pixels, bit for bit"
+        );
+    }
+    assert!(case.exr_bits("caught.exr") != case.exr_bits("plain.exr"), "catching shadows changes the image");
+}

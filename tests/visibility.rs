@@ -155,24 +155,20 @@ fn ground_gbuffer(size: u32, grid: Grid) -> GBuffer {
 
 /// A renderer of `g` in Lambert diffuse with no specular at all (the exact dielectric Fresnel of
 /// specular 0 is 0), white, with the background off and the environment turned `rotation`
-/// degrees: under a white sky, a pixel's radiance is its occlusion.
+/// degrees: under a white sky, a pixel's radiance is its occlusion. Every object catches
+/// shadows when `catcher` is set.
 fn lambert_white(
     ctx: &lookdev::gpu::Context,
     g: &GBuffer,
     env: &Environment,
     rotation: f32,
+    catcher: bool,
 ) -> lookdev::render::Renderer {
     let model = Model { diffuse: Diffuse::Lambert, fresnel: Fresnel::Dielectric, ..Model::default() };
-    let look = common::scenes::look(
-        r#"
-[[object]]
-[[object.layer]]
-[object.layer.set]
-base_color = [1.0, 1.0, 1.0]
-specular = 0.0
-roughness = 1.0
-"#,
-    );
+    let look = common::scenes::look(&format!(
+        "[[object]]\nshadow_catcher = {catcher}\n[[object.layer]]\n[object.layer.set]\n\
+         base_color = [1.0, 1.0, 1.0]\nspecular = 0.0\nroughness = 1.0\n"
+    ));
     let ids = lookdev::render::scene::covered_object_ids(g);
     let stacks = lookdev::material::stack::PackedStacks::pack(&look, ids, g, std::path::Path::new("ground")).unwrap();
     let mut renderer = lookdev::render::Renderer::with_model(ctx, g, env, &model).unwrap();
@@ -188,7 +184,7 @@ fn under_a_white_sky_the_ground_renders_its_stored_occlusion() {
     let grid = Grid::new(32).unwrap();
     let g = ground_gbuffer(size, grid);
     let env = Environment::uniform([1.0; 3], 64, 32);
-    let mut renderer = lambert_white(&ctx, &g, &env, 0.0);
+    let mut renderer = lambert_white(&ctx, &g, &env, 0.0, false);
     let spp = 512;
     renderer.render_samples(spp).unwrap();
     let radiance = renderer.read_radiance().unwrap();
@@ -220,10 +216,56 @@ fn under_a_white_sky_the_ground_renders_its_stored_occlusion() {
     // Without the visibility the same ground is lit by the whole sky.
     let mut open = g.clone();
     open.visibility = None;
-    let mut renderer = lambert_white(&ctx, &open, &env, 0.0);
+    let mut renderer = lambert_white(&ctx, &open, &env, 0.0, false);
     renderer.render_samples(64).unwrap();
     let unoccluded = mean(&mut renderer.read_radiance().unwrap().iter().map(|p| p[1]));
     assert!((unoccluded - 1.0).abs() < 0.01, "{unoccluded}");
+    drop(renderer);
+    common::gpu::finish(ctx);
+}
+
+/// The ground as a shadow catcher under a white sky: its `shadow` share is its stored occlusion
+/// (a white Lambert ground sees all its light unshadowed), ring by ring against the closed
+/// form; over the background (white) it shows that share, and without it a black shadow whose
+/// alpha is 1 minus it.
+#[test]
+fn a_shadow_catcher_under_a_white_sky_is_darkened_by_its_occlusion() {
+    let ctx = common::gpu::context();
+    let size = 48;
+    let g = ground_gbuffer(size, Grid::new(32).unwrap());
+    let env = Environment::uniform([1.0; 3], 64, 32);
+    let mut renderer = lambert_white(&ctx, &g, &env, 0.0, true);
+    assert!(renderer.has_shadow_catcher());
+    renderer.set_lighting(Lighting::default());
+    let spp = 512;
+    renderer.render_samples(spp).unwrap();
+    let share: Vec<f32> = renderer.read_shadow().unwrap().iter().map(|s| s[1]).collect();
+    let shown: Vec<f32> = renderer.read_radiance().unwrap().iter().map(|p| p[1]).collect();
+    for (s, p) in share.iter().zip(&shown) {
+        assert!((s - p).abs() < 1e-5, "over a white background the catcher shows its share: {p} against {s}");
+    }
+    let distance = |p: usize| {
+        let (x, y) = ((p as u32 % size) as f32 + 0.5, (p as u32 / size) as f32 + 0.5);
+        Vec3::new(x / size as f32 * 6.0 - 3.0, 0.0, y / size as f32 * 6.0 - 3.0).length()
+    };
+    let mean =
+        |pixels: &[usize], f: &dyn Fn(usize) -> f32| pixels.iter().map(|&p| f(p)).sum::<f32>() / pixels.len() as f32;
+    for (inner, outer) in [(0.3, 0.7), (0.7, 1.2), (1.2, 2.0), (2.0, 3.0)] {
+        let ring: Vec<usize> = (0..share.len()).filter(|&p| (inner..outer).contains(&distance(p))).collect();
+        let got = mean(&ring, &|p| share[p]);
+        let exact = mean(&ring, &|p| ground_occlusion(distance(p)));
+        eprintln!("ring {inner}-{outer} ({} px): shadow share {got:.4}, closed form {exact:.4}", ring.len());
+        assert!((got - exact).abs() < 0.01, "ring {inner}-{outer}: shadow share {got}, closed form {exact}");
+    }
+
+    // Without the background: black, with 1 minus the share as alpha.
+    renderer.set_lighting(Lighting { background: false, ..Lighting::default() });
+    renderer.render_samples(spp).unwrap();
+    let share = renderer.read_shadow().unwrap();
+    for (s, p) in share.iter().zip(renderer.read_radiance().unwrap()) {
+        assert_eq!(&p[..3], &[0.0; 3]);
+        assert!((p[3] - (1.0 - (s[0] + s[1] + s[2]) / 3.0)).abs() < 1e-5, "alpha {} against share {s:?}", p[3]);
+    }
     drop(renderer);
     common::gpu::finish(ctx);
 }
@@ -240,7 +282,7 @@ fn turning_the_environment_turns_the_shadow_with_it() {
     texels[8 * 64 + 48] = [5000.0; 3];
     let env = Environment::new(64, 32, texels, "a sun");
     let left_and_right = |rotation: f32| {
-        let mut renderer = lambert_white(&ctx, &g, &env, rotation);
+        let mut renderer = lambert_white(&ctx, &g, &env, rotation, false);
         renderer.render_samples(64).unwrap();
         let radiance = renderer.read_radiance().unwrap();
         // The ground just beside the sphere, at x = ∓1.5 (toward −X and toward +X).
@@ -426,6 +468,35 @@ fn an_object_that_sees_no_sky_is_a_warning_and_a_lint_finding() {
         let linted = lookdev(&[&["lint", look.to_str().unwrap()], &args[..]].concat());
         assert!(linted.status.success(), "{args:?}: {}", String::from_utf8_lossy(&linted.stdout));
     }
+
+    // A shadow catcher with no visibility to catch shadows from: a warning and a finding at its
+    // stack's line; with visibility, neither.
+    std::fs::write(&look, "[[object]]\nshadow_catcher = true\n[[object.layer]]\n").unwrap();
+    let expected = "look.toml:1: this stack catches shadows, but";
+    let look = look.to_str().unwrap();
+    let open = open.to_str().unwrap();
+    let rendered = lookdev(&[
+        "render",
+        "--gbuffer",
+        open,
+        "--look",
+        look,
+        "--no-visibility",
+        "--spp",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let text = String::from_utf8_lossy(&rendered.stderr).into_owned();
+    assert!(rendered.status.success() && text.contains(expected), "{text}");
+    let linted = lookdev(&["lint", look, "--gbuffer", open, "--no-visibility"]);
+    let stdout = String::from_utf8_lossy(&linted.stdout).into_owned();
+    assert_eq!(linted.status.code(), Some(1), "{stdout}");
+    assert!(stdout.contains(expected) && stdout.contains("open.exr has no visibility"), "{stdout}");
+    let rendered =
+        lookdev(&["render", "--gbuffer", open, "--look", look, "--spp", "1", "--out", out.to_str().unwrap()]);
+    assert!(!String::from_utf8_lossy(&rendered.stderr).contains("catches shadows"));
+    assert!(lookdev(&["lint", look, "--gbuffer", open]).status.success());
 }
 
 /// Any renderer's file traces its visibility through the scene's triangles given by

@@ -24,6 +24,10 @@ pub struct BenchArgs {
     /// measure what they cost.
     #[arg(long = "aov", value_name = "NAME")]
     pub aovs: Vec<String>,
+    /// The built-in scene's pedestal catches shadows (docs/formats.md#shadow-catchers), to
+    /// measure what a shadow catcher costs.
+    #[arg(long)]
+    pub shadow_catcher: bool,
     /// Instead of throughput, the viewer's wait after an edit: time from a change of the light
     /// to a complete frame at the new state, by a first full pass and by the preview.
     #[arg(long)]
@@ -64,6 +68,19 @@ pub fn builtin_scene(width: u32, height: u32, visibility: bool) -> Result<Scene>
     })
 }
 
+/// The built-in scene's pedestal.
+const PEDESTAL: u32 = 2;
+
+/// Makes object `id` of `scene` catch shadows.
+fn catch_shadows_on(scene: &mut Scene, id: u32) -> Result<()> {
+    let stack = scene.look.objects.iter_mut().find(|o| o.id == Some(id));
+    stack.ok_or_else(|| crate::Error::input(format!("the look has no stack for object {id}")))?.shadow_catcher = true;
+    let covered = crate::render::scene::covered_object_ids(&scene.gbuffer);
+    scene.stacks =
+        crate::material::stack::PackedStacks::pack(&scene.look, covered, &scene.gbuffer, &scene.gbuffer_name)?;
+    Ok(())
+}
+
 pub fn run(args: BenchArgs) -> Result<()> {
     if args.interactive {
         return super::bench_interactive::run(&args);
@@ -90,6 +107,9 @@ pub fn run(args: BenchArgs) -> Result<()> {
         .filter_map(|(on, what)| on.then_some(what))
         .collect();
     println!("accumulated beside the beauty: {}", if beside.is_empty() { "nothing".into() } else { beside.join(", ") });
+    if args.shadow_catcher {
+        println!("shadow catcher: the pedestal (object {PEDESTAL})");
+    }
     println!(
         "{:>10} {:>10} {:>9} {:>16} {:>16} {:>14} {:>12}",
         "size", "visibility", "coverage", "Msamples/s", "Msamples/s", "kernel/1spp", "wall"
@@ -109,7 +129,10 @@ pub fn run(args: BenchArgs) -> Result<()> {
     let mut rates: Vec<(f64, Option<f64>)> = Vec::new();
     let mut without_visibility: Vec<(f64, Option<f64>)> = Vec::new();
     for ((width, height), visibility) in SIZES.into_iter().flat_map(|size| [(size, true), (size, false)]) {
-        let scene = builtin_scene(width, height, visibility)?;
+        let mut scene = builtin_scene(width, height, visibility)?;
+        if args.shadow_catcher {
+            catch_shadows_on(&mut scene, PEDESTAL)?;
+        }
         let gbuffer = &scene.gbuffer;
         let coverage = gbuffer.coverage.iter().filter(|&&a| a > 0.0).count() as f64 / gbuffer.pixel_count() as f64;
         let mut renderer = Renderer::new(&ctx, gbuffer, &scene.environment)?;

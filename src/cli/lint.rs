@@ -129,6 +129,11 @@ pub fn run(args: LintArgs) -> Result<()> {
                 println!("{}: {finding}", read.name.display());
                 count += 1;
             }
+            let covered = covered_object_ids(&read.gbuffer);
+            for finding in crate::render::scene::shadowless_catchers(&look, &covered, &read.gbuffer, &read.name) {
+                println!("{finding}");
+                count += 1;
+            }
             Some(read.gbuffer)
         }
         false => {

@@ -83,20 +83,27 @@ pub struct ObjectStack {
     pub name: Option<String>,
     /// Bottom layer first. Never empty.
     pub layers: Vec<Layer>,
+    /// Whether the object catches shadows (`shadow_catcher = true`): its pixels show what is
+    /// behind them darkened by the share of light the visibility blocks, not its own shading
+    /// (docs/formats.md#shadow-catchers).
+    pub shadow_catcher: bool,
     /// The 1-based line of this `[[object]]` in the file, for later error messages.
     pub line: usize,
 }
 
 impl PartialEq for ObjectStack {
     fn eq(&self, other: &ObjectStack) -> bool {
-        self.id == other.id && self.name == other.name && self.layers == other.layers
+        self.id == other.id
+            && self.name == other.name
+            && self.layers == other.layers
+            && self.shadow_catcher == other.shadow_catcher
     }
 }
 
 impl ObjectStack {
     /// A stack for an object id (`None`: the default stack).
     pub fn new(id: Option<u32>, layers: Vec<Layer>) -> ObjectStack {
-        ObjectStack { id, name: None, layers, line: 0 }
+        ObjectStack { id, name: None, layers, shadow_catcher: false, line: 0 }
     }
 
     /// Whether this is the default stack: neither an id nor a name.
@@ -413,6 +420,9 @@ impl ObjectStack {
             (None, Some(id)) => lines.push(format!("id = {id}")),
             (None, None) => {}
         }
+        if self.shadow_catcher {
+            lines.push("shadow_catcher = true".to_string());
+        }
         for layer in &self.layers {
             layer.write(lines);
         }
@@ -526,6 +536,7 @@ struct RenderFile {
 struct ObjectFile {
     id: Option<Field>,
     name: Option<Field>,
+    shadow_catcher: Option<Field>,
     #[serde(default)]
     layer: Vec<Field<LayerFile>>,
 }
@@ -670,6 +681,8 @@ fn objects(src: &Source, raw: &[Field<ObjectFile>], library: &Library) -> crate:
         let line = src.line(object.span().start);
         let id = src.read("id", &object.get_ref().id, |k, v| input::unsigned(k, v, 0))?;
         let name = src.read("name", &object.get_ref().name, input::text)?;
+        let shadow_catcher =
+            src.read("shadow_catcher", &object.get_ref().shadow_catcher, input::boolean)?.unwrap_or(false);
         if let (Some(_), Some(field)) = (id, &object.get_ref().name) {
             return Err(src.error(field.span(), "an [[object]] has an id or a name, not both"));
         }
@@ -679,7 +692,7 @@ fn objects(src: &Source, raw: &[Field<ObjectFile>], library: &Library) -> crate:
                 return Err(src.error(object.span(), "[[object]] has no layers; add at least one [[object.layer]]"));
             }
             let layers = layers.iter().map(|l| layer(src, l, library)).collect::<crate::Result<_>>()?;
-            stacks.push(ObjectStack { id: None, name, layers, line });
+            stacks.push(ObjectStack { id: None, name, layers, shadow_catcher, line });
             continue;
         }
         if let Some(first) = first_line.insert(id, line) {
@@ -694,7 +707,7 @@ fn objects(src: &Source, raw: &[Field<ObjectFile>], library: &Library) -> crate:
             return Err(src.error(object.span(), "[[object]] has no layers; add at least one [[object.layer]]"));
         }
         let layers = layers.iter().map(|l| layer(src, l, library)).collect::<crate::Result<_>>()?;
-        stacks.push(ObjectStack { id, name: None, layers, line });
+        stacks.push(ObjectStack { id, name: None, layers, shadow_catcher, line });
     }
     Ok(stacks)
 }

@@ -157,14 +157,14 @@ pub fn unused_stack_warnings(look: &Look, object_ids: &[u32], gbuffer_name: &Pat
 }
 
 /// One stack as `resolve.comp` reads it, one RGBA32_UINT texel of its `stacks` image: its first
-/// layer and how many layers it has.
+/// layer, how many layers it has, and whether its object catches shadows (1) or not (0).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GpuStack {
     pub first_layer: u32,
     pub layer_count: u32,
-    pub pad0: u32,
-    pub pad1: u32,
+    pub shadow_catcher: u32,
+    pub pad: u32,
 }
 
 const _: () = assert!(std::mem::size_of::<GpuStack>() == 16);
@@ -204,8 +204,10 @@ impl PackedStacks {
         };
         for id in object_ids {
             let first_layer = packed.layers.len() as u32;
+            let stack = look.stack_for(id);
             let layers: Vec<&Layer> =
-                look.stack_for(id).map(|s| s.layers.iter().filter(|l| l.enabled).collect()).unwrap_or_default();
+                stack.map(|s| s.layers.iter().filter(|l| l.enabled).collect()).unwrap_or_default();
+            let shadow_catcher = stack.is_some_and(|s| s.shadow_catcher) as u32;
             for (i, layer) in layers.iter().enumerate() {
                 // The bottom layer fills: its mask has no effect.
                 let mask = match &layer.mask {
@@ -236,13 +238,13 @@ impl PackedStacks {
             }
             let layer_count = packed.layers.len() as u32 - first_layer;
             packed.stack_of_object.insert(id, packed.stacks.len() as u32);
-            packed.stacks.push(GpuStack { first_layer, layer_count, pad0: 0, pad1: 0 });
+            packed.stacks.push(GpuStack { first_layer, layer_count, shadow_catcher, pad: 0 });
         }
         // Pixels that shade nothing still index a stack; with no shaded object at all, that is
         // a default-material stack.
         if packed.stacks.is_empty() {
             packed.layers.push(GpuLayer::default_material());
-            packed.stacks.push(GpuStack { first_layer: 0, layer_count: 1, pad0: 0, pad1: 0 });
+            packed.stacks.push(GpuStack { first_layer: 0, layer_count: 1, shadow_catcher: 0, pad: 0 });
         }
         Ok(packed)
     }
@@ -258,6 +260,18 @@ impl PackedStacks {
             diffuse: self.layers.iter().any(|l| l.params[metallic] != 1.0 || l.maps[metallic] != NONE),
             clearcoat: self.layers.iter().any(|l| l.params[clearcoat] != 0.0),
         }
+    }
+
+    /// Whether some object catches shadows, so the relight and finalize kernels need the
+    /// unshadowed sums.
+    pub fn has_shadow_catcher(&self) -> bool {
+        self.stacks.iter().any(|s| s.shadow_catcher != 0)
+    }
+
+    /// The objects that catch shadows.
+    pub fn shadow_catcher_objects(&self) -> std::collections::BTreeSet<u32> {
+        let catches = |s: u32| self.stacks[s as usize].shadow_catcher != 0;
+        self.stack_of_object.iter().filter(|(_, &s)| catches(s)).map(|(&id, _)| id).collect()
     }
 
     /// Whether some layer binds a map, so the resolve kernel needs its map code.
@@ -279,7 +293,11 @@ impl PackedStacks {
                 .stacks
                 .iter()
                 .enumerate()
-                .map(|(i, stack)| b.stacks.get(i).is_none_or(|old| layers_of(b, old) != layers_of(self, stack)))
+                .map(|(i, stack)| {
+                    b.stacks.get(i).is_none_or(|old| {
+                        layers_of(b, old) != layers_of(self, stack) || old.shadow_catcher != stack.shadow_catcher
+                    })
+                })
                 .collect(),
             _ => vec![true; self.stacks.len()],
         }

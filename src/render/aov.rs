@@ -9,6 +9,8 @@
 //! - Layers: `layers`, each layer's share of the blend, for every layer of every stack.
 //! - Geometry: `N`, `V` and `objectId`, as the g-buffer has them, and `occlusion`, the
 //!   cosine-weighted share of each pixel's hemisphere its stored visibility sees (1 without).
+//! - Shadow: `shadow`, the share of a shadow catcher's light that reaches it (1 elsewhere),
+//!   the factor its pixels darken what is behind them by; light AOVs are 0 there.
 //! - Error: `variance`, of each pixel's mean luminance.
 //! - Inputs: `masks` and `maps`, the g-buffer's masks and maps as read, as `mask_<name>` and
 //!   `map_<name>`.
@@ -34,6 +36,7 @@ pub enum Aov {
     View,
     ObjectId,
     Occlusion,
+    Shadow,
     Variance,
     /// Every g-buffer mask, as `mask_<name>.Y`.
     Masks,
@@ -64,6 +67,7 @@ impl Aov {
             Aov::View,
             Aov::ObjectId,
             Aov::Occlusion,
+            Aov::Shadow,
             Aov::Variance,
             Aov::Masks,
             Aov::Maps,
@@ -83,6 +87,7 @@ impl Aov {
             Aov::View => "V".into(),
             Aov::ObjectId => "objectId".into(),
             Aov::Occlusion => "occlusion".into(),
+            Aov::Shadow => "shadow".into(),
             Aov::Variance => "variance".into(),
             Aov::Masks => "masks".into(),
             Aov::Maps => "maps".into(),
@@ -195,15 +200,26 @@ pub fn layers(aovs: &[Aov], sources: &Sources) -> Result<Vec<Layer>> {
     } else {
         Vec::new()
     };
+    // A shadow catcher's pixels show no light of their own, so its light AOVs are 0 there.
+    let shown: Vec<f32> = (0..g.pixel_count())
+        .map(|p| {
+            let catches = sources.look.stack_for(g.object_id[p]).is_some_and(|s| s.shadow_catcher);
+            if catches {
+                0.0
+            } else {
+                coverage[p]
+            }
+        })
+        .collect();
     let mut out = Vec::new();
     for &aov in aovs {
         match aov {
             Aov::Lobe(k) => {
-                let values = lobes[k].iter().zip(coverage).map(|(&v, &a)| premultiplied(v, a));
+                let values = lobes[k].iter().zip(&shown).map(|(&v, &a)| premultiplied(v, a));
                 out.push(Layer::color(aov.name(), values));
             }
             Aov::Emission => {
-                let values = materials.iter().zip(coverage).map(|(m, &a)| premultiplied(m.emission, a));
+                let values = materials.iter().zip(&shown).map(|(m, &a)| premultiplied(m.emission, a));
                 out.push(Layer::color(aov.name(), values));
             }
             Aov::Albedo => {
@@ -238,6 +254,7 @@ pub fn layers(aovs: &[Aov], sources: &Sources) -> Result<Vec<Layer>> {
             Aov::View => out.push(Layer::color(aov.name(), g.view.iter().copied())),
             Aov::ObjectId => out.push(Layer::scalar(aov.name(), g.object_id.iter().map(|&id| id as f32).collect())),
             Aov::Occlusion => out.push(Layer::scalar(aov.name(), crate::visibility::occlusion(g))),
+            Aov::Shadow => out.push(Layer::color(aov.name(), sources.renderer.read_shadow()?.into_iter())),
             Aov::Variance => out.push(Layer::scalar(aov.name(), sources.renderer.read_variance(coverage)?)),
             Aov::Masks => {
                 out.extend(g.masks.iter().map(|(name, values)| Layer::scalar(mask_layer(name), values.clone())))

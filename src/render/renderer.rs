@@ -19,6 +19,7 @@ use crate::shading::tonemap::Tonemap;
 use crate::Result;
 use ash::vk;
 use std::cell::{Cell, RefCell};
+use std::collections::BTreeSet;
 
 pub use super::passes::relight::{Accumulate, RelightPush, LOBES};
 pub use super::passes::RESOLVED_LAYERS;
@@ -85,6 +86,10 @@ pub struct Renderer {
     sampling: Sampling,
     /// The lobes the relight kernel is specialised for: those of the stacks last set.
     lobes: LobesPresent,
+    /// Whether the relight kernel sums shadow catchers' unshadowed light, and the objects that
+    /// catch shadows in the stacks last set.
+    shadow_catcher: bool,
+    shadow_catchers: BTreeSet<u32>,
     /// Whether the relight kernel reads the g-buffer's visibility ([`Renderer::set_visibility`]).
     visibility: bool,
     /// Pixel samples a second of its last dispatch that [`super::progressive::accumulate`]
@@ -123,9 +128,13 @@ impl Renderer {
         kernels: KernelSource,
     ) -> Result<Renderer> {
         let (width, height) = (gbuffer.width, gbuffer.height);
-        let Specialization { model, accumulate, product, lobes, maps, visibility } = kernels.specialization();
+        let Specialization { model, accumulate, product, lobes, maps, visibility, shadow_catcher } =
+            kernels.specialization();
         let gpu_gbuffer = GpuGBuffer::upload(ctx, gbuffer)?;
-        let targets = Targets::new(ctx, width, height, accumulate)?;
+        let mut targets = Targets::new(ctx, width, height, accumulate)?;
+        if shadow_catcher {
+            targets.make_unshadowed(ctx)?;
+        }
         let gpu_environment = upload_environment(ctx, environment, sampling)?;
         let lists = PixelLists::new(ctx, gbuffer)?;
         let kernels = kernels.wait(ctx)?;
@@ -166,6 +175,8 @@ impl Renderer {
             denoise: None,
             sampling,
             lobes,
+            shadow_catcher,
+            shadow_catchers: BTreeSet::new(),
             visibility: true,
             pace: None,
             finalized_rows: RefCell::new(vec![false; height as usize]),
@@ -237,6 +248,7 @@ impl Renderer {
                 self.sampling.product_kernel(),
                 self.lobes,
                 self.visibility_side(),
+                self.shadow_catcher,
             )?,
             &model,
             accumulate,
@@ -245,6 +257,8 @@ impl Renderer {
             &self.lists,
             &self.environment,
         )?;
+        // The background pass writes which pixels catch shadows.
+        self.background_rows.fill(false);
         self.restart();
         Ok(())
     }
@@ -432,7 +446,7 @@ impl Renderer {
     /// and the relight kernel is respecialised first if the stacks have other lobes
     /// ([`PackedStacks::lobes`]): a kernel the driver refuses leaves the renderer as it was.
     pub fn set_stacks(&mut self, packed: &PackedStacks) -> Result<()> {
-        self.set_lobes(packed.lobes())?;
+        self.set_kernel_needs(packed)?;
         self.resolve_stacks(packed)?;
         self.restart();
         Ok(())
@@ -446,18 +460,33 @@ impl Renderer {
         Ok(())
     }
 
-    /// Specialises the relight kernel for `lobes` and restarts accumulation, unless it already
-    /// is specialised for them. Returns whether it was respecialised; if that fails, the kernel
-    /// and the lobes it is for stay as they were.
-    fn set_lobes(&mut self, lobes: LobesPresent) -> Result<bool> {
-        if lobes == self.lobes {
+    /// Specialises the relight kernel for the lobes and shadow catchers of `packed` and
+    /// restarts accumulation, unless it already is specialised for them; a change of which
+    /// objects catch shadows restarts it too, as their backgrounds are written again. Returns
+    /// whether accumulation restarted; if respecialising fails, the kernel and what it is for
+    /// stay as they were.
+    fn set_kernel_needs(&mut self, packed: &PackedStacks) -> Result<bool> {
+        let catchers = packed.shadow_catcher_objects();
+        let catchers_changed = catchers != self.shadow_catchers;
+        let (lobes, shadow_catcher) = (packed.lobes(), !catchers.is_empty());
+        if lobes != self.lobes || shadow_catcher != self.shadow_catcher {
+            // The unshadowed sums are made before a kernel writes them (the relight pass binds
+            // them when respecialised).
+            if shadow_catcher && self.targets.make_unshadowed(&self.ctx)? {
+                self.finalize.rebind(&self.gbuffer, &self.targets)?;
+            }
+            let previous = (self.lobes, self.shadow_catcher);
+            (self.lobes, self.shadow_catcher) = (lobes, shadow_catcher);
+            if let Err(e) = self.respecialize(self.relight.shading.model, self.relight.accumulate) {
+                (self.lobes, self.shadow_catcher) = previous;
+                return Err(e);
+            }
+        } else if !catchers_changed {
             return Ok(false);
         }
-        let previous = std::mem::replace(&mut self.lobes, lobes);
-        if let Err(e) = self.respecialize(self.relight.shading.model, self.relight.accumulate) {
-            self.lobes = previous;
-            return Err(e);
-        }
+        self.shadow_catchers = catchers;
+        self.background_rows.fill(false);
+        self.restart();
         Ok(true)
     }
 
@@ -828,6 +857,29 @@ impl Renderer {
             .collect())
     }
 
+    /// Per pixel of an object that catches shadows, the share of its light that reaches it, per
+    /// channel: its sums over its unshadowed sums, as finalize.comp divides them (1 in a channel
+    /// with no light even unshadowed). 1 on every other pixel (docs/formats.md#shadow-catchers).
+    pub fn read_shadow(&self) -> Result<Vec<[f32; 3]>> {
+        let sums = self.read_sums()?;
+        if !self.shadow_catcher {
+            return Ok(vec![[1.0; 3]; sums.len()]);
+        }
+        let open: Vec<[f32; 4]> = bytemuck::cast_slice(&self.targets.unshadowed.read(&self.ctx)?).to_vec();
+        let behind: Vec<[f32; 4]> = bytemuck::cast_slice(&self.targets.background.read(&self.ctx)?).to_vec();
+        Ok((0..sums.len())
+            .map(|p| {
+                let catcher = self.lists.covered_mask[p] && behind[p][3] != 0.0;
+                std::array::from_fn(|c| if catcher && open[p][c] != 0.0 { sums[p][c] / open[p][c] } else { 1.0 })
+            })
+            .collect())
+    }
+
+    /// Whether the kernels sum shadow catchers' unshadowed light: some object catches shadows.
+    pub fn has_shadow_catcher(&self) -> bool {
+        self.shadow_catcher
+    }
+
     /// The variance of each covered pixel's mean luminance, from the sum of the estimates and of
     /// their squares: (Σx² − (Σx)²/n) / (n(n − 1)); zero with fewer than two samples. Needs
     /// [`Accumulate::variance`].
@@ -885,9 +937,9 @@ impl Renderer {
     /// another specialisation of the relight kernel ([`PackedStacks::lobes`]): then everything
     /// restarts, as with [`Renderer::set_stacks`], and this returns None.
     pub fn set_stacks_local(&mut self, packed: &PackedStacks) -> Result<Option<usize>> {
-        let respecialised = self.set_lobes(packed.lobes())?;
+        let restarted = self.set_kernel_needs(packed)?;
         self.resolve_stacks(packed)?;
-        if respecialised {
+        if restarted {
             return Ok(None);
         }
         let changed = self.resolve.changed_pixels(self.width as usize * self.height as usize)?;
@@ -959,6 +1011,8 @@ pub struct Specialization {
     pub maps: bool,
     /// The side of the g-buffer's visibility grid, 0 without visibility.
     pub visibility: u32,
+    /// Whether some object catches shadows ([`PackedStacks::has_shadow_catcher`]).
+    pub shadow_catcher: bool,
 }
 
 impl Default for Specialization {
@@ -971,6 +1025,7 @@ impl Default for Specialization {
             lobes: LobesPresent::default(),
             maps: false,
             visibility: 0,
+            shadow_catcher: false,
         }
     }
 }
@@ -988,6 +1043,7 @@ impl Specialization {
             lobes: scene.stacks.lobes(),
             maps: scene.stacks.binds_maps(),
             visibility: scene.gbuffer.visibility.as_ref().map_or(0, |v| v.grid.side()),
+            shadow_catcher: scene.stacks.has_shadow_catcher(),
         }
     }
 }
@@ -1004,10 +1060,10 @@ impl Kernels {
     /// Compiles them, the relight kernel (by far the slowest) first. Pipeline creation is
     /// thread-safe, so this may run on any thread while the context is used on others.
     pub fn compile(ctx: &Context, specialization: Specialization) -> Result<Kernels> {
-        let Specialization { model, accumulate, product, lobes, maps, visibility } = specialization;
+        let Specialization { model, accumulate, product, lobes, maps, visibility, shadow_catcher } = specialization;
         Ok(Kernels {
             specialization,
-            relight: RelightPass::pipeline(ctx, &model, accumulate, product, lobes, visibility)?,
+            relight: RelightPass::pipeline(ctx, &model, accumulate, product, lobes, visibility, shadow_catcher)?,
             resolve: ResolvePass::pipeline(ctx, maps)?,
             finalize: FinalizePass::pipeline(ctx, false)?,
         })

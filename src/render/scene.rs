@@ -74,6 +74,7 @@ impl Scene {
         let covered = covered_object_ids(&gbuffer);
         let stacks = PackedStacks::pack(&look, covered.iter().copied(), &gbuffer, &gbuffer_name)?;
         look_warnings(&look, &covered, &gbuffer_name).into_iter().for_each(crate::warn);
+        shadowless_catchers(&look, &covered, &gbuffer, &gbuffer_name).into_iter().for_each(crate::warn);
         dark_render_warnings(&gbuffer, &gbuffer_name, &environment, settings.lighting.intensity)
             .into_iter()
             .for_each(crate::warn);
@@ -156,6 +157,7 @@ pub fn load_look_for(path: &Path, gbuffer: &GBuffer, gbuffer_name: &Path) -> Res
     let covered = covered_object_ids(gbuffer);
     let stacks = PackedStacks::pack(&look, covered.iter().copied(), gbuffer, gbuffer_name)?;
     warnings.extend(look_warnings(&look, &covered, gbuffer_name));
+    warnings.extend(shadowless_catchers(&look, &covered, gbuffer, gbuffer_name));
     Ok((look, stacks, warnings))
 }
 
@@ -174,6 +176,30 @@ pub fn look_warnings(look: &Look, covered: &[u32], gbuffer_name: &Path) -> Vec<S
         ));
     }
     warnings
+}
+
+/// One line for each stack of a covered object that catches shadows when `gbuffer` has no
+/// visibility (or it is left out): nothing can shadow it, so it shows the background unchanged.
+pub fn shadowless_catchers(look: &Look, covered: &[u32], gbuffer: &GBuffer, gbuffer_name: &Path) -> Vec<String> {
+    if gbuffer.visibility.is_some() {
+        return Vec::new();
+    }
+    let file = look.file.as_deref().map(|p| p.display().to_string()).unwrap_or_else(|| "the look".into());
+    look.objects
+        .iter()
+        .filter(|stack| {
+            stack.shadow_catcher
+                && covered.iter().any(|&id| look.stack_for(id).is_some_and(|s| std::ptr::eq(s, *stack)))
+        })
+        .map(|stack| {
+            format!(
+                "{file}:{}: this stack catches shadows, but {} has no visibility (or --no-visibility leaves it out), \
+                 so its objects show the background unshadowed",
+                stack.line,
+                gbuffer_name.display()
+            )
+        })
+        .collect()
 }
 
 /// The environment a look's settings name, or the default built-in.

@@ -22,6 +22,8 @@ pub enum Action {
     AddPresetLayer(String),
     /// Sets the mask of the selected layer, after checking that the g-buffer has it.
     SetMask(Option<String>),
+    /// Makes the selected object (the default stack when none is) catch shadows, or not.
+    SetShadowCatcher(bool),
     /// Binds a parameter of the selected layer to a g-buffer map (`None`: unbinds it), after
     /// checking that the g-buffer has the map and that it fits the parameter.
     SetMap {

@@ -403,6 +403,12 @@ impl Running {
                 document.select(Selection { object: Some(object), layer: top });
                 return Ok(Some(format!("added {preset} on top of {object}")));
             }
+            Action::SetShadowCatcher(catcher) => {
+                let object = document.selection().object.unwrap_or(ObjectRef::Default);
+                document.apply(Edit::SetShadowCatcher { object, catcher }).map_err(Error::input)?;
+                let what = if catcher { "catches shadows" } else { "no longer catches shadows" };
+                return Ok(Some(format!("{object} {what}")));
+            }
             Action::SetMask(mask) => {
                 if let Some(name) = mask.as_ref().filter(|m| !self.session.masks().contains(m)) {
                     let has = self.session.masks().join(", ");

@@ -65,7 +65,7 @@ impl LayerChange {
 const COMMANDS: &str = "select, set, reset, map, add, remove, duplicate, move, show, hide, mask, invert, opacity, \
     rotate, intensity, background, env, exposure, tonemap, spp, seed, undo, redo, pick, inspect, wait-spp, save-look, \
     save-preset, save-image, screenshot, open-look, quit, answer, compare, divider, key, zoom, view, clipping, probe, \
-    snapshot, restore, delete-snapshot, denoise, visibility";
+    snapshot, restore, delete-snapshot, denoise, visibility, catcher";
 
 impl Script {
     pub fn load(path: &Path) -> Result<Script> {
@@ -388,6 +388,10 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
         "visibility" => {
             arity(1)?;
             Ok(Step::Do(Action::Visibility(switch(args[0])?)))
+        }
+        "catcher" => {
+            arity(1)?;
+            Ok(Step::Do(Action::SetShadowCatcher(switch(args[0])?)))
         }
         other => Err(format!("unknown command '{other}' (expected one of: {COMMANDS})")),
     }

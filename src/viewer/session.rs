@@ -176,6 +176,7 @@ fn stacks_renderer(
         lobes: packed.lobes(),
         maps: packed.binds_maps(),
         visibility: gbuffer.visibility.as_ref().map_or(0, |v| v.grid.side()),
+        shadow_catcher: packed.has_shadow_catcher(),
         ..Specialization::default()
     });
     let mut renderer = Renderer::with_kernels(ctx, gbuffer, environment, sampling, kernels)?;

@@ -119,6 +119,11 @@ pub enum Edit {
         layer: usize,
         opacity: f32,
     },
+    /// Makes an object catch shadows, or not (`shadow_catcher` in the look format).
+    SetShadowCatcher {
+        object: ObjectRef,
+        catcher: bool,
+    },
     /// Gives an object a stack of its own, a copy of the default stack (or one default-material
     /// layer). Nothing happens when it already has one.
     CreateStack {
@@ -283,6 +288,10 @@ impl State {
                 layer_mut(stack, object, layer)?.opacity = opacity;
                 Ok(())
             })?,
+            Edit::SetShadowCatcher { object, catcher } => next.edit_stack(object, |stack| {
+                stack.shadow_catcher = catcher;
+                Ok(())
+            })?,
             Edit::CreateStack { id } => {
                 stack_mut(&mut next.look, ObjectRef::Id(id));
             }
@@ -338,9 +347,9 @@ impl State {
     ) -> Result<(), String> {
         let created = !has_stack(&self.look, object);
         let stack = stack_mut(&mut self.look, object);
-        let fresh = created.then(|| stack.layers.clone());
+        let fresh = created.then(|| stack.clone());
         edit(stack)?;
-        if fresh.is_some_and(|layers| layers == stack.layers) {
+        if fresh.is_some_and(|fresh| fresh == *stack) {
             // The created stack is the last one.
             self.look.objects.pop();
         }
@@ -390,11 +399,11 @@ fn stack_mut(look: &mut Look, object: ObjectRef) -> &mut ObjectStack {
     let index = match look.objects.iter().position(|o| o.is_for(id)) {
         Some(index) => index,
         None => {
-            let layers = match look.objects.iter().find(|o| o.is_default()) {
-                Some(default) => default.layers.clone(),
-                None => vec![Layer::filling(Params::default())],
+            let (layers, shadow_catcher) = match look.objects.iter().find(|o| o.is_default()) {
+                Some(default) => (default.layers.clone(), default.shadow_catcher),
+                None => (vec![Layer::filling(Params::default())], false),
             };
-            look.objects.push(ObjectStack::new(id, layers));
+            look.objects.push(ObjectStack { shadow_catcher, ..ObjectStack::new(id, layers) });
             look.objects.len() - 1
         }
     };

@@ -39,35 +39,58 @@ impl<'a> Reference<'a> {
     pub fn pixel(&self, x: u32, y: u32, params: &Params, spp: u32) -> Vec4 {
         let i = (y * self.gbuffer.width + x) as usize;
         let coverage = self.gbuffer.coverage[i];
-        let mean = if coverage > 0.0 { self.sum(x, y, params, spp) / spp as f32 } else { Vec3::ZERO };
+        let mean = if coverage > 0.0 { self.sums(x, y, params, spp).0 / spp as f32 } else { Vec3::ZERO };
         if self.lighting.background {
-            (coverage * mean + (1.0 - coverage) * self.background(x, y)).extend(1.0)
+            (coverage * mean + (1.0 - coverage) * self.background(x, y, false)).extend(1.0)
         } else {
             (coverage * mean).extend(coverage)
         }
     }
 
+    /// The same for a covered pixel of an object that catches shadows: the background darkened
+    /// by the share of light that reaches it (its sum over its unshadowed sum, per channel), or,
+    /// without the background, a black shadow whose alpha is 1 minus that share's mean.
+    pub fn catcher_pixel(&self, x: u32, y: u32, params: &Params, spp: u32) -> Vec4 {
+        let i = (y * self.gbuffer.width + x) as usize;
+        let coverage = self.gbuffer.coverage[i];
+        let share = self.shadow(x, y, params, spp);
+        if self.lighting.background {
+            let behind = self.background(x, y, true);
+            (coverage * share * behind + (1.0 - coverage) * behind).extend(1.0)
+        } else {
+            Vec4::new(0.0, 0.0, 0.0, coverage * (1.0 - (share.x + share.y + share.z) / 3.0))
+        }
+    }
+
+    /// The share of a catcher's light that reaches it, per channel: the `shadow` AOV.
+    pub fn shadow(&self, x: u32, y: u32, params: &Params, spp: u32) -> Vec3 {
+        let (sum, open) = self.sums(x, y, params, spp);
+        let share = |s: f32, o: f32| if o != 0.0 { s / o } else { 1.0 };
+        Vec3::new(share(sum.x, open.x), share(sum.y, open.y), share(sum.z, open.z))
+    }
+
     /// What the first pass stores as the environment behind pixel (x, y).
-    fn background(&self, x: u32, y: u32) -> Vec3 {
+    fn background(&self, x: u32, y: u32, catcher: bool) -> Vec3 {
         let g = self.gbuffer;
         let i = (y * g.width + x) as usize;
         let rotation = self.lighting.rotation_degrees.to_radians();
         let to_env = |d: Vec3| environment_from_world(d, rotation.cos(), rotation.sin());
-        if g.coverage[i] < 1.0 {
+        if g.coverage[i] < 1.0 || catcher {
             self.lighting.intensity * background(self.env, direction_to_uv(to_env(-Vec3::from(g.view[i]))))
         } else {
             Vec3::ZERO
         }
     }
 
-    /// The accumulation image's running sum of estimates for a covered pixel.
-    fn sum(&self, x: u32, y: u32, params: &Params, spp: u32) -> Vec3 {
+    /// The accumulation image's running sum of estimates for a covered pixel, and the sum of
+    /// the same estimates with every direction seen (a shadow catcher's unshadowed sum).
+    fn sums(&self, x: u32, y: u32, params: &Params, spp: u32) -> (Vec3, Vec3) {
         let g = self.gbuffer;
         let i = (y * g.width + x) as usize;
         let view = Vec3::from(g.view[i]);
         let rotation = self.lighting.rotation_degrees.to_radians();
         let (cos_r, sin_r) = (rotation.cos(), rotation.sin());
-        let mut sum = Vec3::ZERO;
+        let (mut sum, mut open) = (Vec3::ZERO, Vec3::ZERO);
         let n = Vec3::from(g.normal[i]);
         let frame = Frame::new(n, Vec3::from(g.tangent[i]));
         let v = frame.to_local(view);
@@ -99,33 +122,39 @@ impl<'a> Reference<'a> {
         };
         let emission = Vec3::from(params.emission);
         if v.z <= 0.0 {
-            return (0..spp).fold(sum, |sum, _| sum + emission);
+            let sum = (0..spp).fold(sum, |sum, _| sum + emission);
+            return (sum, sum);
         }
         for s in 0..spp {
-            let mut radiance = Vec3::ZERO;
+            let (mut radiance, mut unshadowed) = (Vec3::ZERO, Vec3::ZERO);
             let (u_env, u_brdf): (Vec2, Vec2) = (sobol_owen_2d(s, env_seed), sobol_owen_2d(s, brdf_seed));
             let (d, t) = sample_env(u_env);
             let (le, pdf_env) = (Vec3::from(self.env.texel(t.x, t.y)), pdf_env(t));
             let l = env_frame.to_local(d);
-            if l.z > 0.0 && pdf_env > 0.0 && seen(d) {
+            if l.z > 0.0 && pdf_env > 0.0 {
                 let hv = make_half_vector(&lobes, l, v);
                 let f = disney_brdf(&lobes, &view_terms, l, &hv);
                 let pdf_brdf = brdf_pdf(&choice, &view_terms, l, &hv);
-                radiance += f * (l.z * mis_weight_over_pdf(pdf_env, pdf_brdf)) * le;
+                let light = f * (l.z * mis_weight_over_pdf(pdf_env, pdf_brdf)) * le;
+                radiance += if seen(d) { light } else { Vec3::ZERO };
+                unshadowed += light;
             }
             let l = sample_brdf(&lobes, &choice, &view_terms, u_brdf);
             if l.z > 0.0 {
                 let hv = make_half_vector(&lobes, l, v);
                 let pdf_brdf = brdf_pdf(&choice, &view_terms, l, &hv);
                 let d = env_frame.to_world(l).normalize();
-                if pdf_brdf > 0.0 && seen(d) {
+                if pdf_brdf > 0.0 {
                     let (le, pdf_env) = texel(d);
                     let f = disney_brdf(&lobes, &view_terms, l, &hv);
-                    radiance += f * (l.z * mis_weight_over_pdf(pdf_brdf, pdf_env)) * le;
+                    let light = f * (l.z * mis_weight_over_pdf(pdf_brdf, pdf_env)) * le;
+                    radiance += if seen(d) { light } else { Vec3::ZERO };
+                    unshadowed += light;
                 }
             }
             sum += emission + radiance * self.lighting.intensity;
+            open += emission + unshadowed * self.lighting.intensity;
         }
-        sum
+        (sum, open)
     }
 }

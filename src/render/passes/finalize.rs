@@ -11,8 +11,9 @@ use ash::vk;
 /// What `finalize.comp` and the host agree on.
 pub const INTERFACE: Interface = Interface::compute(&shaders::FINALIZE, &[&SET], Some(FinalizePush::GLSL));
 
-/// Set 0 of `finalize.comp`: accumulation, background, surface, radiance, display, object ids.
-pub const SET: [BindingKind; 6] = [BindingKind::StorageImage; 6];
+/// Set 0 of `finalize.comp`: accumulation, background, surface, radiance, display, object ids,
+/// unshadowed sums.
+pub const SET: [BindingKind; 7] = [BindingKind::StorageImage; 7];
 
 /// `Finalize` in finalize.comp.
 #[repr(C)]
@@ -65,6 +66,15 @@ impl FinalizePass {
         Ok(())
     }
 
+    /// Binds the pipelines to `targets` again, after one of their images was replaced.
+    pub fn rebind(&mut self, gbuffer: &GpuGBuffer, targets: &Targets) -> Result<()> {
+        self.set = FinalizePass::bind(&self.pipeline, gbuffer, targets)?;
+        if let Some((pipeline, set)) = &mut self.preview {
+            *set = FinalizePass::bind(pipeline, gbuffer, targets)?;
+        }
+        Ok(())
+    }
+
     fn bind(pipeline: &ComputePipeline, gbuffer: &GpuGBuffer, targets: &Targets) -> Result<DescriptorSet> {
         pipeline.bind(
             0,
@@ -75,6 +85,7 @@ impl FinalizePass {
                 Binding::Image(&targets.radiance),
                 Binding::Image(&targets.display),
                 Binding::Image(&gbuffer.object_ids),
+                Binding::Image(&targets.unshadowed),
             ],
         )
     }

@@ -66,6 +66,9 @@ pub struct Targets {
     pub lobe_sums: Image,
     /// The sums of each estimate's squared luminance (r), for the variance AOV.
     pub moments: Image,
+    /// Each covered pixel's sum of estimates with nothing blocked, where some object catches
+    /// shadows (a 1×1 placeholder where none does).
+    pub unshadowed: Image,
     /// Linear radiance, finalize's output.
     pub radiance: Image,
     /// sRGB-encoded RGBA8 display pixels, finalize's output.
@@ -82,6 +85,7 @@ impl Targets {
             background: float(1)?,
             lobe_sums,
             moments,
+            unshadowed: Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, 1, 1, 1, false)?,
             radiance: float(1)?,
             display: Image::display(ctx, width, height)?,
         })
@@ -92,6 +96,20 @@ impl Targets {
         let (width, height) = (self.accumulation.width, self.accumulation.height);
         (self.lobe_sums, self.moments) = accumulation_images(ctx, width, height, accumulate)?;
         Ok(())
+    }
+}
+
+impl Targets {
+    /// Makes the unshadowed sums full size, for a shadow catcher, unless they are. Returns
+    /// whether the image was replaced (the passes bound to it must bind the new one). They stay
+    /// full size when no object catches shadows any more: the kernels then ignore them.
+    pub fn make_unshadowed(&mut self, ctx: &Context) -> Result<bool> {
+        let (width, height) = (self.accumulation.width, self.accumulation.height);
+        if (self.unshadowed.width, self.unshadowed.height) == (width, height) {
+            return Ok(false);
+        }
+        self.unshadowed = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 1, false)?;
+        Ok(true)
     }
 }
 

@@ -23,8 +23,8 @@ pub const INTERFACE: Interface =
 
 /// Set 0 of `relight.comp`: surface, resolved material, accumulation, background, energy
 /// table, lobe sums, squared luminances, the covered and restarted pixel lists, the active
-/// counts and the visibility. Set 1 is the environment's.
-pub const SET: [BindingKind; 11] = [
+/// counts, the visibility and the unshadowed sums. Set 1 is the environment's.
+pub const SET: [BindingKind; 12] = [
     BindingKind::StorageImage,
     BindingKind::StorageImage,
     BindingKind::StorageImage,
@@ -35,6 +35,7 @@ pub const SET: [BindingKind; 11] = [
     BindingKind::StorageImage,
     BindingKind::StorageImage,
     BindingKind::StorageBuffer,
+    BindingKind::StorageImage,
     BindingKind::StorageImage,
 ];
 
@@ -124,7 +125,8 @@ pub struct RelightPass {
 impl RelightPass {
     /// Compiles `relight.comp` specialised for `model` and `accumulate`, sampling the environment
     /// by the product tables when `product` is set, with the code of the lobes in `lobes` only,
-    /// and reading visibility on a grid of `visibility_side` cells a side (0: none).
+    /// reading visibility on a grid of `visibility_side` cells a side (0: none), and summing
+    /// shadow catchers' unshadowed light when `shadow_catcher` is set.
     pub fn pipeline(
         ctx: &Context,
         model: &Model,
@@ -132,10 +134,11 @@ impl RelightPass {
         product: bool,
         lobes: LobesPresent,
         visibility_side: u32,
+        shadow_catcher: bool,
     ) -> Result<ComputePipeline> {
         let mut constants = model.specialization().to_vec();
         constants.extend([accumulate.lobes as u32, accumulate.variance as u32, product as u32]);
-        constants.extend([lobes.diffuse as u32, lobes.clearcoat as u32, visibility_side]);
+        constants.extend([lobes.diffuse as u32, lobes.clearcoat as u32, visibility_side, shadow_catcher as u32]);
         ComputePipeline::specialized(ctx, &shaders::RELIGHT, INTERFACE.sets, INTERFACE.push_size(), &constants)
     }
 
@@ -174,6 +177,7 @@ impl RelightPass {
                 Binding::Image(&lists.restarted_image),
                 Binding::Buffer(&lists.active),
                 Binding::Image(&gbuffer.visibility),
+                Binding::Image(&targets.unshadowed),
             ],
         )?;
         let environment_set = pipeline.bind(1, &environment.bindings())?;

@@ -31,6 +31,11 @@ pub fn show(ui: &mut egui::Ui, session: &Session, actions: &mut Vec<Action>) -> 
     if !own {
         ui.label(RichText::new("Shows the default stack; the first edit gives this object a copy of its own.").weak());
     }
+    let mut catcher = stack.shadow_catcher;
+    let hint = "Show only the shadows other objects cast on it, over the background, as Cycles' shadow catcher";
+    if ui.checkbox(&mut catcher, "Shadow catcher").on_hover_text(hint).changed() {
+        actions.push(Action::SetShadowCatcher(catcher));
+    }
     let add = layer_list(ui, object, stack, selection, actions);
     if let Some(index) = selection.layer.filter(|&i| i < stack.layers.len()) {
         ui.separator();
