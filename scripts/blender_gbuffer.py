@@ -2,7 +2,7 @@
 
     blender -b shot.blend --python-exit-code 2 --python scripts/blender_gbuffer.py -- --out shot.exr
         [--size W H] [--samples N] [--view-layer NAME] [--camera NAME]
-        [--matte-material NAME]... [--matte-attribute NAME]... [--visibility SIDE|off]
+        [--matte-material NAME]... [--matte-attribute NAME]... [--visibility SIDE|off] [--supersample N]
 
 It renders the scene's active camera with Cycles into one multilayer OpenEXR holding what
 lookdev reads (docs/formats.md#production-renders):
@@ -14,6 +14,9 @@ lookdev reads (docs/formats.md#production-renders):
   made real), in lookdev's Y-up world, beside the EXR as NAME.occluders.glb and named in the
   note: lookdev traces each pixel's shadows and occlusion through them from the Position pass
   (docs/formats.md#occluders), over SIDE² directions (--visibility, default 32);
+- with --supersample N, N times the resolution on each side, recorded in the note: lookdev
+  relights each pixel's surfaces apart and filters its renders down to the scene's resolution
+  (docs/formats.md#supersampled-g-buffers);
 - custom mattes on request, as shader AOVs named mask_<name>: 1 on the surfaces of each
   --matte-material, and the value of each --matte-attribute (a named attribute of the
   geometry, such as a painted vertex group or a colour attribute's first channel).
@@ -44,6 +47,15 @@ def arguments():
     parser.add_argument("--camera", help="the camera object to render (default: the scene's)")
     parser.add_argument("--matte-material", action="append", default=[], help="a material to matte")
     parser.add_argument("--matte-attribute", action="append", default=[], help="a named attribute to matte")
+    parser.add_argument(
+        "--supersample",
+        type=int,
+        default=1,
+        choices=range(1, 9),
+        metavar="N",
+        help="write N times the resolution on each side, for lookdev to relight each pixel's surfaces apart "
+        "and filter down (1 to 8, default 1)",
+    )
     parser.add_argument(
         "--visibility",
         default="32",
@@ -244,6 +256,13 @@ def main():
     if args.size:
         scene.render.resolution_x, scene.render.resolution_y = args.size
         scene.render.resolution_percentage = 100
+    if args.supersample > 1:
+        # The output size as Blender makes it, then N times that, exactly.
+        render = scene.render
+        width = render.resolution_x * render.resolution_percentage // 100
+        height = render.resolution_y * render.resolution_percentage // 100
+        render.resolution_x, render.resolution_y = width * args.supersample, height * args.supersample
+        render.resolution_percentage = 100
 
     view_layer.use_pass_normal = True
     view_layer.use_pass_position = True
@@ -265,6 +284,8 @@ def main():
             matte_attribute(material, name)
 
     note = camera_note(scene.camera)
+    if args.supersample > 1:
+        note += f" supersample={args.supersample}"
     if args.visibility != "off":
         render_visibility(scene, view_layer)
         casters = shadow_casters(view_layer)

@@ -66,26 +66,27 @@ fn renders() -> Option<&'static Path> {
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join("scene.py"), scene_script(SCENE)).unwrap();
         std::fs::write(dir.join("look.toml"), look()).unwrap();
+        std::fs::write(
+            dir.join("catcher.toml"),
+            look().replacen("\n[[object.layer]]", "\nshadow_catcher = true\n[[object.layer]]", 1),
+        )
+        .unwrap();
         let environment = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/environment/studio.exr");
         let script = dir.join("scene.py");
-        for (mode, out) in [("blend", "scene.blend"), ("beauty", "beauty.exr")] {
+        for (mode, out) in [("blend", "scene.blend"), ("beauty", "beauty.exr"), ("catcher:Ground", "catcher.exr")] {
             let out = dir.join(out);
             let args = [script.to_str().unwrap(), "--", mode, out.to_str().unwrap(), environment.to_str().unwrap()];
             run_blender(&blender, &[&["--python"], &args[..]].concat());
         }
         let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/blender_gbuffer.py");
-        let out = dir.join("gbuffer.exr");
-        run_blender(
-            &blender,
-            &[
-                dir.join("scene.blend").to_str().unwrap(),
-                "--python",
-                shipped.to_str().unwrap(),
-                "--",
-                "--out",
-                out.to_str().unwrap(),
-            ],
-        );
+        // The g-buffer at the scene's resolution, and at twice it.
+        for (out, extra) in [("gbuffer.exr", &[][..]), ("gbuffer2.exr", &["--supersample", "2"][..])] {
+            let out = dir.join(out);
+            let scene = dir.join("scene.blend");
+            let args =
+                [scene.to_str().unwrap(), "--python", shipped.to_str().unwrap(), "--", "--out", out.to_str().unwrap()];
+            run_blender(&blender, &[&args[..], extra].concat());
+        }
         Some(dir)
     })
     .as_deref()
@@ -94,12 +95,17 @@ fn renders() -> Option<&'static Path> {
 /// `lookdev render` of the script's g-buffer with the look, as Blender lit it, in `dir`, with a
 /// cache folder of its own.
 fn render(dir: &Path, out: &str, extra: &[&str]) -> Output {
+    render_with(dir, "gbuffer.exr", "look.toml", out, extra)
+}
+
+/// The same of the g-buffer file `gbuffer` with the look file `look`.
+fn render_with(dir: &Path, gbuffer: &str, look: &str, out: &str, extra: &[&str]) -> Output {
     let mut args = vec![
         "render",
         "--gbuffer",
-        "gbuffer.exr",
+        gbuffer,
         "--look",
-        "look.toml",
+        look,
         "--env",
         "builtin:studio",
         // Blender's equirectangular centre is +X; lookdev's is −Z.
@@ -160,9 +166,17 @@ fn bias_and_error(ours: &Image, cycles: &Image, pixels: &[usize]) -> (f64, f64) 
 
 type Image = std::collections::BTreeMap<String, Vec<f32>>;
 
-/// Per object, the bias and mean relative error inside it (see [`objects`]); printed with those
-/// of the pixels at edges (every covered pixel inside no object).
-fn errors(dir: &Path, relit: &str) -> (Vec<(String, f64, f64)>, f64) {
+/// A render's errors against Cycles: per object, the bias and mean relative error inside it
+/// (see [`objects`]); the bias of every covered pixel; the bias and mean relative error of the
+/// pixels at edges (every covered pixel inside no object).
+struct Errors {
+    objects: Vec<(String, f64, f64)>,
+    whole: f64,
+    edges: (f64, f64),
+}
+
+/// The [`Errors`] of `relit`, printed.
+fn errors(dir: &Path, relit: &str) -> Errors {
     let (ours, _) = read_channels(&dir.join(relit).to_string_lossy());
     let (cycles, _) = read_channels(&dir.join("beauty.exr").to_string_lossy());
     let objects = objects(dir);
@@ -170,12 +184,12 @@ fn errors(dir: &Path, relit: &str) -> (Vec<(String, f64, f64)>, f64) {
     let inside: std::collections::BTreeSet<usize> = objects.iter().flat_map(|(_, p)| p.iter().copied()).collect();
     let covered = |p: usize| mattes.iter().any(|(_, coverage)| coverage[p] > 0.0);
     let edges: Vec<usize> = (0..WIDTH * HEIGHT).filter(|&p| covered(p) && !inside.contains(&p)).collect();
-    let (bias, relative) = bias_and_error(&ours, &cycles, &edges);
+    let edge_errors = bias_and_error(&ours, &cycles, &edges);
     eprintln!(
         "{relit} edges: {} pixels, bias {:+.2}%, mean relative error {:.1}%",
         edges.len(),
-        bias * 100.0,
-        relative * 100.0
+        edge_errors.0 * 100.0,
+        edge_errors.1 * 100.0
     );
     let all: Vec<usize> = (0..WIDTH * HEIGHT).filter(|&p| covered(p)).collect();
     let (whole, relative) = bias_and_error(&ours, &cycles, &all);
@@ -198,7 +212,7 @@ fn errors(dir: &Path, relit: &str) -> (Vec<(String, f64, f64)>, f64) {
             (name, bias, relative)
         })
         .collect();
-    (objects, whole)
+    Errors { objects, whole, edges: edge_errors }
 }
 
 #[test]
@@ -208,7 +222,7 @@ fn a_blender_scene_relights_with_its_shadows_like_cycles() {
     assert_success(&output);
     let text = stderr(&output);
     assert!(text.contains("visibility from gbuffer.occluders.glb, traced over 32² directions"), "{text}");
-    let (shadowed, whole) = errors(dir, "relit.exr");
+    let Errors { objects: shadowed, whole, .. } = errors(dir, "relit.exr");
     assert!(whole.abs() < 0.04, "the whole image's mean is {:+.1}% off Cycles'", whole * 100.0);
     assert_eq!(shadowed.len(), 4, "four objects: {shadowed:?}");
     for (name, bias, relative) in &shadowed {
@@ -218,7 +232,7 @@ fn a_blender_scene_relights_with_its_shadows_like_cycles() {
     }
     // Without the shadows, the open box and the ground are far too bright.
     assert_success(&render(dir, "unshadowed.exr", &["--no-visibility"]));
-    let (unshadowed, _) = errors(dir, "unshadowed.exr");
+    let unshadowed = errors(dir, "unshadowed.exr").objects;
     let worst = unshadowed.iter().map(|(_, bias, _)| *bias).fold(0.0, f64::max);
     assert!(worst > 0.1, "without shadows the worst bias is only {:+.1}%", worst * 100.0);
 
@@ -227,6 +241,73 @@ fn a_blender_scene_relights_with_its_shadows_like_cycles() {
     assert_success(&again);
     assert!(stderr(&again).contains("32² directions (cached)"), "{}", stderr(&again));
     assert_eq!(std::fs::read(dir.join("relit.exr")).unwrap(), std::fs::read(dir.join("again.exr")).unwrap());
+}
+
+/// The ground as a shadow catcher, in lookdev and in Cycles: inside the ground, lookdev's
+/// `shadow` share matches Cycles' Shadow Catcher pass (the factor each shows the plate darkened
+/// by), over the shadows and over the whole ground.
+#[test]
+fn a_shadow_catcher_matches_cycles_shadow_catcher() {
+    let Some(dir) = renders() else { return };
+    assert!(look().starts_with("[[object]]\nname = \"Ground\"\n"), "the ground's stack comes first");
+    let aovs = ["--aov", "shadow", "--aov", "light", "--aov", "occlusion"];
+    assert_success(&render_with(dir, "gbuffer.exr", "catcher.toml", "caught.exr", &aovs));
+    let (ours, _) = read_channels(&dir.join("caught.exr").to_string_lossy());
+    let (cycles, _) = read_channels(&dir.join("catcher.exr").to_string_lossy());
+    let pass = "ViewLayer.Shadow Catcher.";
+    assert!(cycles.contains_key(&format!("{pass}R")), "Cycles' passes: {:?}", cycles.keys().collect::<Vec<_>>());
+    let ground = objects(dir).into_iter().find(|(name, _)| name == "Ground").unwrap().1;
+    let share = |image: &Image, prefix: &str, p: usize| {
+        luminance(["R", "G", "B"].map(|c| image[&format!("{prefix}{c}")][p] as f64))
+    };
+    // In the shadows (chosen by the stored visibility's exact occlusion, not by either render's
+    // noisy values, which would bias that render's mean), and over the whole ground.
+    let shadowed: Vec<usize> = ground.iter().copied().filter(|&p| ours["occlusion.Y"][p] < 0.8).collect();
+    assert!(shadowed.len() > 200, "only {} ground pixels in shadow", shadowed.len());
+    for (what, pixels) in [("shadows", &shadowed), ("ground", &ground)] {
+        let mean = |image: &Image, prefix: &str| {
+            pixels.iter().map(|&p| share(image, prefix, p)).sum::<f64>() / pixels.len() as f64
+        };
+        let (lookdev, path_traced) = (mean(&ours, "shadow."), mean(&cycles, pass));
+        let error = pixels.iter().map(|&p| (share(&ours, "shadow.", p) - share(&cycles, pass, p)).abs()).sum::<f64>()
+            / pixels.len() as f64;
+        eprintln!(
+            "{what}: {} pixels, mean share lookdev {lookdev:.4}, Cycles {path_traced:.4}, mean absolute difference {error:.4}",
+            pixels.len()
+        );
+        assert!(
+            (lookdev - path_traced).abs() < 0.02,
+            "{what}: mean share {lookdev:.3} against Cycles' {path_traced:.3}"
+        );
+        assert!(error < 0.04, "{what}: the shares differ by {error:.3} on average");
+    }
+    assert!(ground.iter().all(|&p| ours["diffuse.G"][p] == 0.0), "the catcher shows none of its own light");
+}
+
+/// Pixels that hold more than one surface: the script's g-buffer at twice the resolution
+/// (`--supersample 2`), relit pixel by pixel and filtered down, lowers the error of the edge
+/// pixels against Cycles, and keeps every object within 3% inside.
+#[test]
+fn a_supersampled_gbuffer_lowers_the_error_at_edges() {
+    let Some(dir) = renders() else { return };
+    assert_success(&render(dir, "plain.exr", &[]));
+    let supersampled = render_with(dir, "gbuffer2.exr", "look.toml", "supersampled.exr", &[]);
+    assert_success(&supersampled);
+    assert!(stderr(&supersampled).contains("(160x120 from a g-buffer supersampled 2x2,"), "{}", stderr(&supersampled));
+    let (before, after) = (errors(dir, "plain.exr"), errors(dir, "supersampled.exr"));
+    let ((bias_before, error_before), (bias_after, error_after)) = (before.edges, after.edges);
+    assert!(
+        error_after < 0.8 * error_before && bias_after.abs() < bias_before.abs(),
+        "edges: bias {:+.1}% → {:+.1}%, mean relative error {:.1}% → {:.1}%",
+        bias_before * 100.0,
+        bias_after * 100.0,
+        error_before * 100.0,
+        error_after * 100.0
+    );
+    for (name, bias, _) in &after.objects {
+        assert!(bias.abs() < 0.03, "{name}: supersampled, the mean is {:+.1}% off Cycles'", bias * 100.0);
+    }
+    assert!(after.whole.abs() < before.whole.abs().max(0.01), "the whole image: {:+.2}%", after.whole * 100.0);
 }
 
 #[test]

@@ -847,6 +847,7 @@ impl Accumulator {
             visibility: None,
             has_view: true,
             has_tangent: true,
+            supersample: 1,
         }
     }
 }

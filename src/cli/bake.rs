@@ -40,6 +40,10 @@ pub struct BakeArgs {
     /// Samples per pixel for antialiased coverage, normals, masks and maps (1 to 1024).
     #[arg(long, default_value_t = 16)]
     pub samples: u32,
+    /// Write the g-buffer at N times --size on each side, recording N, so that renders relight
+    /// each pixel's surfaces apart and filter down to --size (edges and creases; 1 to 8).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub supersample: u32,
     /// Each pixel's visibility, traced through the asset's triangles: the side of its grid of
     /// directions (8, 16, 32 or 64; 32 stores 1024 directions, 128 bytes a pixel), or off.
     #[arg(long, value_name = "SIDE|off", default_value = "32", value_parser = parse_visibility)]
@@ -70,6 +74,10 @@ pub fn check(args: &BakeArgs) -> Result<()> {
     if !(1..=MAX_SAMPLES).contains(&args.samples) {
         return Err(Error::input(format!("--samples {}: must be 1 to {MAX_SAMPLES}", args.samples)));
     }
+    let max = crate::gbuffer::MAX_SUPERSAMPLE;
+    if !(1..=max).contains(&args.supersample) {
+        return Err(Error::input(format!("--supersample {}: must be 1 to {max}", args.supersample)));
+    }
     Ok(())
 }
 
@@ -98,8 +106,8 @@ pub fn run(args: BakeArgs) -> Result<()> {
         crate::warn(format!("{}: ignoring unsupported extensions: {}", args.model.display(), unsupported.join(", ")));
     }
     let options = BakeOptions {
-        width: args.size[0],
-        height: args.size[1],
+        width: args.size[0].saturating_mul(args.supersample),
+        height: args.size[1].saturating_mul(args.supersample),
         samples: args.samples,
         camera,
         visibility: args.visibility.0,
@@ -108,7 +116,7 @@ pub fn run(args: BakeArgs) -> Result<()> {
     let ctx = crate::gpu::Context::new(&ContextOptions { graphics: true, ..ContextOptions::from_env(args.device) })?;
     let counter = ctx.validation_counter();
     let device_name = ctx.info().name.clone();
-    let gbuffer = {
+    let mut gbuffer = {
         let mut current: Option<(Step, Progress)> = None;
         let gbuffer = bake(&ctx, &asset, &options, |step, done, total| {
             if current.as_ref().is_none_or(|(s, _)| *s != step) {
@@ -139,10 +147,15 @@ pub fn run(args: BakeArgs) -> Result<()> {
             args.model.display()
         ));
     }
+    gbuffer.supersample = args.supersample;
     gbuffer.write(&args.out)?;
     if !args.quiet {
+        let supersampled = match args.supersample {
+            1 => String::new(),
+            n => format!(", supersampled {n}x{n} for {}x{}", args.size[0], args.size[1]),
+        };
         eprintln!(
-            "lookdev: wrote {} ({}x{}, {} objects, {} masks, {} maps, {} samples, {:.2} s on {device_name})",
+            "lookdev: wrote {} ({}x{}{supersampled}, {} objects, {} masks, {} maps, {} samples, {:.2} s on {device_name})",
             args.out.display(),
             gbuffer.width,
             gbuffer.height,

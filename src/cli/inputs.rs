@@ -97,6 +97,11 @@ pub struct GBufferArgs {
     /// --gbuffer-channel normal=N_world. Repeatable; mask adds one each time.
     #[arg(long = "gbuffer-channel", value_name = "ROLE=NAME")]
     pub channels: Vec<String>,
+    /// The g-buffer was written at N times the output's resolution on each side: every pixel is
+    /// relit, then each N x N block averaged, so edges and creases are shaded surface by surface
+    /// (default: the factor the file records, else 1; 1 to 8).
+    #[arg(long, value_name = "N")]
+    pub supersample: Option<u32>,
     /// Relight as if nothing stood between any surface and the sky, leaving out the g-buffer's
     /// visibility (its shadows and occlusion), for comparison.
     #[arg(long)]
@@ -134,6 +139,7 @@ impl GBufferArgs {
             file: self.gbuffer.clone(),
             source,
             ignore_visibility: self.no_visibility,
+            supersample: self.supersample,
             ..GBufferSpec::default()
         })
     }

@@ -5,6 +5,7 @@ use super::progress::Progress;
 use crate::gpu::{Context, ContextOptions};
 use crate::render::aov::{self, Aov};
 use crate::render::compare::{self, Summary};
+use crate::render::downsample;
 use crate::render::output::{self, Metadata, OutputFormat};
 use crate::render::progressive::{self, RenderStats};
 use crate::render::renderer::{KernelSource, Specialization};
@@ -84,6 +85,31 @@ struct Rendered {
     stats: RenderStats,
 }
 
+impl Rendered {
+    /// The render filtered down by the g-buffer's supersampling `factor`
+    /// (crate::render::downsample): the display pixels are made again from the filtered radiance.
+    fn downsampled(self, factor: u32, settings: &Settings) -> Rendered {
+        if factor == 1 {
+            return self;
+        }
+        let radiance = self.radiance.map(|r| downsample::box_filter(&r, self.width, factor));
+        let display = match &radiance {
+            Some(r) if !self.display.is_empty() => {
+                downsample::display(r, settings.exposure, settings.tonemap, settings.lighting.background)
+            }
+            _ => Vec::new(),
+        };
+        Rendered {
+            width: self.width / factor,
+            height: self.height / factor,
+            display,
+            radiance,
+            aovs: self.aovs.into_iter().map(|layer| downsample::layer(layer, self.width, factor)).collect(),
+            stats: self.stats,
+        }
+    }
+}
+
 /// Relights `scene` on `ctx` with `kernels` (specialised for the settings and `aovs`, see
 /// [`kernels_for`]) and reads back what the output needs: the radiance, the AOVs `aovs`, and
 /// the display pixels when `display` is set.
@@ -114,14 +140,15 @@ fn render(
     drop(timing);
     let _timing = crate::timings::phase("read back");
     let sources = aov::Sources { gbuffer: &scene.gbuffer, look: &scene.look, renderer: &renderer };
-    Ok(Rendered {
+    let rendered = Rendered {
         width: renderer.width,
         height: renderer.height,
         display: if display { renderer.read_display(settings.exposure, settings.tonemap)? } else { Vec::new() },
         radiance: Some(renderer.read_radiance()?),
         aovs: aov::layers(aovs, &sources)?,
         stats,
-    })
+    };
+    Ok(rendered.downsampled(scene.gbuffer.supersample, settings))
 }
 
 pub fn run(args: RenderArgs) -> Result<()> {
@@ -167,10 +194,14 @@ pub fn run(args: RenderArgs) -> Result<()> {
             None => format!("{} spp", settings.spp),
         };
         eprintln!(
-            "lookdev: wrote {} ({}x{}, {spp}, {:.2} s on {device_name})",
+            "lookdev: wrote {} ({}x{}{}, {spp}, {:.2} s on {device_name})",
             args.out.display(),
-            scene.gbuffer.width,
-            scene.gbuffer.height,
+            rendered.width,
+            rendered.height,
+            match scene.gbuffer.supersample {
+                1 => String::new(),
+                n => format!(" from a g-buffer supersampled {n}x{n}"),
+            },
             rendered.stats.wall.as_secs_f64()
         );
     }

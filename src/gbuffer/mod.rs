@@ -53,6 +53,10 @@ pub const VISIBILITY_PREFIX: &str = "visibility.";
 /// The full name behind a mask whose channel name had to be shortened or made safe is stored
 /// in the header attribute with this prefix followed by the mask's name.
 pub const MASK_NAME_PREFIX: &str = "maskName.";
+/// The text attribute that records a supersampled g-buffer's factor ([`GBuffer::supersample`]).
+pub const SUPERSAMPLE_ATTRIBUTE: &str = "supersample";
+/// The largest supersampling factor: 64 g-buffer pixels an output pixel.
+pub const MAX_SUPERSAMPLE: u32 = 8;
 
 /// The view vector of a file without `V.*`: an orthographic camera looking down −Z.
 pub const DEFAULT_VIEW: [f32; 3] = [0.0, 0.0, 1.0];
@@ -98,6 +102,22 @@ pub struct GBuffer {
     pub has_view: bool,
     /// Whether the file carried `T.*`.
     pub has_tangent: bool,
+    /// G-buffer pixels per side of an output pixel: the file was written at this multiple of the
+    /// output resolution, and renders relight every pixel, then average each block
+    /// (docs/formats.md#supersampled-g-buffers). 1 for a plain g-buffer.
+    pub supersample: u32,
+}
+
+/// Whether a `width` × `height` g-buffer can be `factor` times its output's resolution on each
+/// side: a factor of 1 to [`MAX_SUPERSAMPLE`] that divides both sides.
+pub fn check_supersample(factor: u32, width: u32, height: u32) -> Result<(), String> {
+    if !(1..=MAX_SUPERSAMPLE).contains(&factor) {
+        return Err(format!("a supersampling factor is 1 to {MAX_SUPERSAMPLE}, not {factor}"));
+    }
+    if width % factor != 0 || height % factor != 0 {
+        return Err(format!("{width}x{height} pixels are not a multiple of {factor} on each side"));
+    }
+    Ok(())
 }
 
 /// Whether `name` can name a map in a look: not empty, no spaces around it, no control
@@ -203,5 +223,16 @@ impl GBuffer {
             return self.masks.get(name).map(Vec::as_slice);
         }
         channel.strip_prefix(MAP_PREFIX).and_then(|name| self.maps.get(name)).map(Vec::as_slice)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_factor_divides_both_sides_and_is_bounded() {
+        assert_eq!(super::check_supersample(2, 8, 6), Ok(()));
+        assert!(super::check_supersample(2, 8, 5).unwrap_err().contains("8x5"));
+        assert!(super::check_supersample(9, 9, 9).unwrap_err().contains("1 to 8"));
+        assert!(super::check_supersample(0, 8, 8).is_err());
     }
 }

@@ -95,6 +95,7 @@ impl GBuffer {
             }),
             has_view: true,
             has_tangent: true,
+            supersample: 1,
         }
     }
 }

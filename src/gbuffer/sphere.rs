@@ -52,6 +52,7 @@ impl GBuffer {
             visibility: None,
             has_view: true,
             has_tangent: true,
+            supersample: 1,
         };
         // World units per pixel, and the world position of pixel (0, 0)'s top-left corner.
         let pixel = 2.0 * SPHERE_FRAME_HALF_EXTENT / width.min(height) as f32;

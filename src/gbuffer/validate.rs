@@ -29,6 +29,8 @@ pub(crate) struct RawImage {
     pub mask_names: BTreeMap<String, String>,
     /// What the file offers for tracing visibility; validation leaves it to the reader.
     pub surfaces: super::source::Surfaces,
+    /// The supersampling factor the file declares, as written, and where.
+    pub supersample: Option<(String, &'static str)>,
 }
 
 /// A normal shorter than this is "clearly empty": it marks background in files without `A`, and
@@ -114,6 +116,16 @@ impl Checker<'_> {
             visibility: self.visibility(&raw.channels)?,
             has_view: raw_view.is_some(),
             has_tangent: raw_tangent.is_some(),
+            supersample: match &raw.supersample {
+                Some((text, from)) => {
+                    let factor =
+                        text.parse::<u32>().map_err(|_| self.error(format!("{from} {text} is not a whole number")))?;
+                    super::check_supersample(factor, width, height)
+                        .map_err(|problem| self.error(format!("{from}: {problem}")))?;
+                    factor
+                }
+                None => 1,
+            },
         };
         Ok((gbuffer, self.warnings))
     }
@@ -572,6 +584,7 @@ mod tests {
             object_name_attributes: Vec::new(),
             mask_names: BTreeMap::new(),
             surfaces: Default::default(),
+            supersample: None,
         }
     }
 

@@ -93,6 +93,10 @@ impl GBuffer {
         for (mask, name) in &self.mask_names {
             attributes.other.insert(text(&format!("{MASK_NAME_PREFIX}{mask}")), AttributeValue::Text(text(name)));
         }
+        if self.supersample > 1 {
+            let factor = AttributeValue::Text(text(&self.supersample.to_string()));
+            attributes.other.insert(text(super::SUPERSAMPLE_ATTRIBUTE), factor);
+        }
 
         let encoding =
             Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };

@@ -34,6 +34,7 @@ pub fn sphere(size: u32) -> GBuffer {
         visibility: None,
         has_view: false,
         has_tangent: false,
+        supersample: 1,
     };
     for y in 0..size {
         for x in 0..size {

@@ -1,6 +1,7 @@
 //! Many renders of one g-buffer under one environment, each with its own look: contact sheets,
 //! wedges and turntables. The renderer, g-buffer and environment are set up once.
 
+use super::downsample;
 use super::progressive;
 use super::renderer::KernelSource;
 use super::sampling::Sampling;
@@ -48,12 +49,14 @@ impl<'a> Batch<'a> {
         Ok(Batch { renderer, gbuffer, gbuffer_name, environment })
     }
 
+    /// The renders' width: the g-buffer's, over its supersampling factor.
     pub fn width(&self) -> u32 {
-        self.gbuffer.width
+        self.gbuffer.width / self.gbuffer.supersample
     }
 
+    /// The renders' height: the g-buffer's, over its supersampling factor.
     pub fn height(&self) -> u32 {
-        self.gbuffer.height
+        self.gbuffer.height / self.gbuffer.supersample
     }
 
     /// Renders `look` with `settings` (environment file excepted: the batch's is fixed) to
@@ -73,20 +76,34 @@ impl<'a> Batch<'a> {
         Ok(())
     }
 
-    /// The last render as display pixels (RGBA8).
+    /// The last render as display pixels (RGBA8), filtered down by the g-buffer's supersampling
+    /// factor (the display pixels then made from the filtered radiance).
     pub fn display(&self, settings: &Settings) -> Result<Vec<u8>> {
-        self.renderer.read_display(settings.exposure, settings.tonemap)
+        match self.gbuffer.supersample {
+            1 => self.renderer.read_display(settings.exposure, settings.tonemap),
+            _ => {
+                let (exposure, tonemap, background) =
+                    (settings.exposure, settings.tonemap, settings.lighting.background);
+                Ok(downsample::display(&self.radiance()?, exposure, tonemap, background))
+            }
+        }
     }
 
-    /// The last render as linear radiance.
+    /// The last render as linear radiance, filtered down by the g-buffer's supersampling factor.
     pub fn radiance(&self) -> Result<Vec<[f32; 4]>> {
-        self.renderer.read_radiance()
+        let radiance = self.renderer.read_radiance()?;
+        Ok(match self.gbuffer.supersample {
+            1 => radiance,
+            factor => downsample::box_filter(&radiance, self.gbuffer.width, factor),
+        })
     }
 
-    /// The last render's AOVs (`settings.aovs`), of `look`.
+    /// The last render's AOVs (`settings.aovs`), of `look`, filtered down likewise.
     pub fn aovs(&self, look: &Look, settings: &Settings) -> Result<Vec<super::aov::Layer>> {
         let sources = super::aov::Sources { gbuffer: self.gbuffer, look, renderer: &self.renderer };
-        super::aov::layers(&settings.aovs, &sources)
+        let layers = super::aov::layers(&settings.aovs, &sources)?;
+        let (width, factor) = (self.gbuffer.width, self.gbuffer.supersample);
+        Ok(layers.into_iter().map(|layer| downsample::layer(layer, width, factor)).collect())
     }
 }
 

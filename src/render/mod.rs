@@ -3,6 +3,7 @@
 pub mod aov;
 pub mod batch;
 pub mod compare;
+pub mod downsample;
 pub mod energy;
 pub mod output;
 pub mod passes;

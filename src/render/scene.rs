@@ -133,6 +133,9 @@ pub struct GBufferSpec {
     /// Leaves the g-buffer's visibility out (`--no-visibility`): every direction above the
     /// horizon is seen, as in a g-buffer without it.
     pub ignore_visibility: bool,
+    /// The g-buffer's supersampling factor (`--supersample`), instead of the one its file
+    /// records ([`GBuffer::supersample`]).
+    pub supersample: Option<u32>,
 }
 
 /// A look made ready to render with `sets`: with any, it gets a default stack if it has none,
@@ -260,6 +263,12 @@ pub fn read_gbuffer(spec: &GBufferSpec, look: &mut Look, quiet: bool) -> Result<
             (GBuffer::shaderball_with(width, height, visibility), PathBuf::from("built-in shader ball"))
         }
     };
+    let mut gbuffer = gbuffer;
+    if let Some(factor) = spec.supersample {
+        crate::gbuffer::check_supersample(factor, gbuffer.width, gbuffer.height)
+            .map_err(|problem| crate::Error::input_file(&name, format!("--supersample {factor}: {problem}")))?;
+        gbuffer.supersample = factor;
+    }
     let claims = look.resolve_object_names(&gbuffer.object_names, &name)?;
     Ok(ReadGBuffer { gbuffer, name, claims })
 }

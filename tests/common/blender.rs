@@ -121,8 +121,9 @@ pub fn mean(image: &BTreeMap<String, Vec<f32>>, prefix: &str, pixels: &[usize]) 
 /// arguments mode, output and environment; an empty Cycles scene at 160×120 on the CPU; the
 /// materials `red` and `gold`, and `material(name, colour, metallic, roughness)` for more) and
 /// the common end: the world lit by the environment, and the modes `blend` (save the scene),
-/// `plain` (Blender's passes: Normal, Position, Depth, Cryptomatte) and `beauty` (Cycles'
-/// direct light, no bounces, 256 samples).
+/// `plain` (Blender's passes: Normal, Position, Depth, Cryptomatte), `beauty` (Cycles'
+/// direct light, no bounces, 256 samples) and `catcher:NAME` (the same with the object NAME
+/// a shadow catcher, and Cycles' Shadow Catcher pass, as multilayer EXR).
 pub fn scene_script(body: &str) -> String {
     format!("{SCENE_START}{body}{SCENE_END}")
 }
@@ -176,6 +177,14 @@ elif mode == "beauty":
     scene.cycles.samples = 256
     scene.cycles.max_bounces = 0
     settings.file_format = 'OPEN_EXR'
+    settings.color_depth = '32'
+    bpy.ops.render.render(write_still=True)
+elif mode.startswith("catcher:"):
+    bpy.data.objects[mode.split(":", 1)[1]].is_shadow_catcher = True
+    layer.cycles.use_pass_shadow_catcher = True
+    scene.cycles.samples = 256
+    scene.cycles.max_bounces = 0
+    settings.file_format = 'OPEN_EXR_MULTILAYER'
     settings.color_depth = '32'
     bpy.ops.render.render(write_still=True)
 "#;

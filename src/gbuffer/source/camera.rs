@@ -29,6 +29,12 @@ pub struct Camera {
 pub const NOTE_ATTRIBUTE: &str = "Note";
 pub const NOTE_PREFIX: &str = "lookdev.camera";
 
+/// The value of `key=` in lookdev's note, if the header has the note and the note the key.
+pub fn note_field<'a>(text: &'a BTreeMap<String, String>, key: &str) -> Option<&'a str> {
+    let note = text.get(NOTE_ATTRIBUTE)?.strip_prefix(NOTE_PREFIX)?;
+    note.split_whitespace().find_map(|w| w.strip_prefix(key)?.strip_prefix('='))
+}
+
 /// The camera the header records: OpenEXR's `worldToCamera` (with `worldToNDC` telling an
 /// orthographic camera from a perspective one), else lookdev's note. Matrices are stored for
 /// row vectors (`p · M`), and cameras look down their −Z.

@@ -416,6 +416,7 @@ fn lookdev(merged: Merged, options: &SourceOptions) -> (RawImage, Detected, Vec<
         .iter()
         .filter_map(|(name, value)| Some((name.strip_prefix(super::MASK_NAME_PREFIX)?.to_string(), value.clone())))
         .collect();
+    let supersample = merged.text.get(super::SUPERSAMPLE_ATTRIBUTE).map(|t| (t.clone(), "the header's supersample"));
     let raw = RawImage {
         width: merged.width,
         height: merged.height,
@@ -423,6 +424,7 @@ fn lookdev(merged: Merged, options: &SourceOptions) -> (RawImage, Detected, Vec<
         object_name_attributes,
         mask_names,
         surfaces: Surfaces::default(),
+        supersample,
     };
     let detected = Detected { source: Source::Lookdev, layer: merged.part, up, from: Vec::new() };
     (raw, detected, Vec::new())
@@ -676,6 +678,8 @@ fn other(
         positions: position.as_ref().map(|(_, names)| unfiltered(converted(names))),
         occluders: occluders::from_note(&merged.text, folder).map_err(bad)?,
     };
+    let supersample =
+        camera::note_field(&merged.text, "supersample").map(|t| (t.to_string(), "the note's supersample="));
     let raw = RawImage {
         width: merged.width,
         height: merged.height,
@@ -683,6 +687,7 @@ fn other(
         object_name_attributes: object_names,
         mask_names,
         surfaces,
+        supersample,
     };
     Ok((raw, Detected { source, layer, up, from }))
 }

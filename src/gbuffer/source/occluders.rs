@@ -2,7 +2,7 @@
 //! scene's triangles beside its g-buffer and names them in the render's note, after the camera:
 //! `lookdev.camera … occluders=NAME visibility=SIDE` (docs/formats.md#occluders).
 
-use super::camera::{NOTE_ATTRIBUTE, NOTE_PREFIX};
+use super::camera::note_field;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -19,10 +19,7 @@ pub struct Occluders {
 
 /// The occluders the header's note names, with their file relative to `folder` (the g-buffer's).
 pub fn from_note(text: &BTreeMap<String, String>, folder: &Path) -> Result<Option<Occluders>, String> {
-    let Some(note) = text.get(NOTE_ATTRIBUTE).and_then(|n| n.strip_prefix(NOTE_PREFIX)) else {
-        return Ok(None);
-    };
-    let field = |key: &str| note.split_whitespace().find_map(|w| w.strip_prefix(&format!("{key}=")));
+    let field = |key: &str| note_field(text, key);
     let Some(name) = field("occluders") else { return Ok(None) };
     let name = percent_encoding::percent_decode_str(name)
         .decode_utf8()
@@ -39,6 +36,7 @@ pub fn from_note(text: &BTreeMap<String, String>, folder: &Path) -> Result<Optio
 
 #[cfg(test)]
 mod tests {
+    use super::super::camera::NOTE_ATTRIBUTE;
     use super::*;
 
     fn note(text: &str) -> BTreeMap<String, String> {
