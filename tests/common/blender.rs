@@ -117,77 +117,21 @@ pub fn mean(image: &BTreeMap<String, Vec<f32>>, prefix: &str, pixels: &[usize]) 
     sum
 }
 
-/// A test scene's Blender script: `body` (its objects and camera) between the common start (the
-/// arguments mode, output and environment; an empty Cycles scene at 160×120 on the CPU; the
-/// materials `red` and `gold`, and `material(name, colour, metallic, roughness)` for more) and
-/// the common end: the world lit by the environment, and the modes `blend` (save the scene),
-/// `plain` (Blender's passes: Normal, Position, Depth, Cryptomatte), `beauty` (Cycles'
-/// direct light, no bounces, 256 samples) and `catcher:NAME` (the same with the object NAME
-/// a shadow catcher, and Cycles' Shadow Catcher pass, as multilayer EXR).
+/// A test scene's Blender script: `body` (its objects and camera) between the common start,
+/// `tests/data/blender/start.py` (the arguments mode, output and environment; an empty Cycles
+/// scene at 160×120 on the CPU; the materials `red` and `gold`, and `material(name, colour,
+/// metallic, roughness)` for more) and the common end, `end.py`: the world lit by the
+/// environment, and the modes `blend` (save the scene), `plain` (Blender's passes: Normal,
+/// Position, Depth, Cryptomatte), `beauty` (Cycles' direct light, no bounces, 256 samples,
+/// printing the render's seconds) and `catcher:NAME` (the same with the object NAME a shadow
+/// catcher, and Cycles' Shadow Catcher pass, as multilayer EXR).
 pub fn scene_script(body: &str) -> String {
     format!("{SCENE_START}{body}{SCENE_END}")
 }
 
-const SCENE_START: &str = r#"
-import bpy, bmesh, sys
-mode, out, environment = sys.argv[sys.argv.index("--") + 1:]
-bpy.ops.wm.read_factory_settings(use_empty=True)
-scene = bpy.context.scene
-scene.render.engine = 'CYCLES'
-scene.cycles.device = 'CPU'
-scene.cycles.use_denoising = False
-scene.cycles.use_adaptive_sampling = False
-scene.render.resolution_x, scene.render.resolution_y = 160, 120
-scene.render.resolution_percentage = 100
-def material(name, color, metallic, roughness):
-    m = bpy.data.materials.new(name)
-    m.use_nodes = True
-    p = m.node_tree.nodes["Principled BSDF"]
-    p.distribution = 'GGX'
-    p.inputs["Base Color"].default_value = (*color, 1)
-    p.inputs["Metallic"].default_value = metallic
-    p.inputs["Roughness"].default_value = roughness
-    p.inputs["Specular"].default_value = 0.5
-    return m
-red = material("Red Paint", (0.8, 0.1, 0.05), 0.0, 0.4)
-gold = material("Gold", (1.0, 0.766, 0.336), 1.0, 0.3)
-"#;
+const SCENE_START: &str = include_str!("../data/blender/start.py");
 
-const SCENE_END: &str = r#"
-world = bpy.data.worlds.new("World")
-scene.world = world
-world.use_nodes = True
-texture = world.node_tree.nodes.new("ShaderNodeTexEnvironment")
-texture.image = bpy.data.images.load(environment)
-world.node_tree.links.new(texture.outputs["Color"], world.node_tree.nodes["Background"].inputs["Color"])
-layer = scene.view_layers[0]
-layer.cycles.denoising_store_passes = False
-settings = scene.render.image_settings
-scene.render.filepath = out
-if mode == "blend":
-    bpy.ops.wm.save_as_mainfile(filepath=out)
-elif mode == "plain":
-    scene.cycles.samples = 16
-    layer.use_pass_normal = layer.use_pass_position = layer.use_pass_z = True
-    layer.use_pass_cryptomatte_object = layer.use_pass_cryptomatte_material = layer.use_pass_cryptomatte_asset = True
-    settings.file_format = 'OPEN_EXR_MULTILAYER'
-    settings.color_depth = '32'
-    bpy.ops.render.render(write_still=True)
-elif mode == "beauty":
-    scene.cycles.samples = 256
-    scene.cycles.max_bounces = 0
-    settings.file_format = 'OPEN_EXR'
-    settings.color_depth = '32'
-    bpy.ops.render.render(write_still=True)
-elif mode.startswith("catcher:"):
-    bpy.data.objects[mode.split(":", 1)[1]].is_shadow_catcher = True
-    layer.cycles.use_pass_shadow_catcher = True
-    scene.cycles.samples = 256
-    scene.cycles.max_bounces = 0
-    settings.file_format = 'OPEN_EXR_MULTILAYER'
-    settings.color_depth = '32'
-    bpy.ops.render.render(write_still=True)
-"#;
+const SCENE_END: &str = include_str!("../data/blender/end.py");
 
 /// The scenes' materials as lookdev sets them: `red` and `gold` of [`scene_script`], and a grey.
 pub const RED: &str = "base_color = [0.8, 0.1, 0.05]\nmetallic = 0.0\nroughness = 0.4\nspecular = 0.5\n";
