@@ -2,7 +2,7 @@
 
     blender -b shot.blend --python-exit-code 2 --python scripts/blender_gbuffer.py -- --out shot.exr
         [--size W H] [--samples N] [--view-layer NAME] [--camera NAME]
-        [--matte-material NAME]... [--matte-attribute NAME]... [--visibility SIDE|off] [--supersample N]
+        [--matte-material NAME]... [--matte-attribute NAME]... [--visibility SIDE|auto|off] [--supersample N]
 
 It renders the scene's active camera with Cycles into one multilayer OpenEXR holding what
 lookdev reads (docs/formats.md#production-renders):
@@ -13,7 +13,8 @@ lookdev reads (docs/formats.md#production-renders):
 - the scene's shadow-casting triangles as they render (modifiers at render levels, instances
   made real), in lookdev's Y-up world, beside the EXR as NAME.occluders.glb and named in the
   note: lookdev traces each pixel's shadows and occlusion through them from the Position pass
-  (docs/formats.md#occluders), over SIDE² directions (--visibility, default 32);
+  (docs/formats.md#occluders), over SIDE² directions (--visibility; by default lookdev's
+  choice, 64² up to half a megapixel and 32² above);
 - with --supersample N, N times the resolution on each side, recorded in the note: lookdev
   relights each pixel's surfaces apart and filters its renders down to the scene's resolution
   (docs/formats.md#supersampled-g-buffers);
@@ -58,9 +59,10 @@ def arguments():
     )
     parser.add_argument(
         "--visibility",
-        default="32",
-        choices=["8", "16", "32", "64", "off"],
-        help="directions a side lookdev traces shadows over, or off to write no occluders (default 32)",
+        default="auto",
+        choices=["8", "16", "32", "64", "auto", "off"],
+        help="directions a side lookdev traces shadows over; auto (the default) leaves the choice to lookdev: "
+        "64 up to half a megapixel, 32 above; off writes no occluders",
     )
     return parser.parse_args(argv)
 
@@ -297,7 +299,9 @@ def main():
             triangles = sum(len(corners) for _, corners, _ in casters) // 3
             print(f"blender_gbuffer.py: {triangles} shadow-casting triangles written to {path}")
             name = urllib.parse.quote(os.path.basename(path))
-            note += f" occluders={name} visibility={args.visibility}"
+            note += f" occluders={name}"
+            if args.visibility != "auto":
+                note += f" visibility={args.visibility}"
     scene.render.use_stamp_note = True
     scene.render.stamp_note_text = note
     scene.render.use_compositing = False

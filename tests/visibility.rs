@@ -559,8 +559,9 @@ fn a_hand_mapped_file_is_traced_through_the_occluders_it_is_given() {
     };
     let read = GBuffer::read_with(&path, &options).unwrap();
     let visibility = read.gbuffer.visibility.as_ref().expect("traced through the occluders");
-    assert_eq!(visibility.grid, Grid::new(visibility::DEFAULT_SIDE).unwrap());
-    assert!(read.detected.summary(&path).contains("visibility from sphere-on-ground.glb, traced over 32² directions"));
+    // A small image gets the fine grid by default.
+    assert_eq!(visibility.grid, Grid::new(visibility::default_side(size * size)).unwrap());
+    assert!(read.detected.summary(&path).contains("visibility from sphere-on-ground.glb, traced over 64² directions"));
     let occlusion = visibility::occlusion(&read.gbuffer);
     let worst = (0..size * size).filter_map(|p| exact[p].map(|e: f32| (occlusion[p] - e).abs())).fold(0.0f32, f32::max);
     eprintln!("hand-mapped, traced through glTF occluders: worst occlusion error {worst:.4}");

@@ -45,8 +45,9 @@ pub struct BakeArgs {
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub supersample: u32,
     /// Each pixel's visibility, traced through the asset's triangles: the side of its grid of
-    /// directions (8, 16, 32 or 64; 32 stores 1024 directions, 128 bytes a pixel), or off.
-    #[arg(long, value_name = "SIDE|off", default_value = "32", value_parser = parse_visibility)]
+    /// directions (8, 16, 32 or 64; 32 stores 1024 directions, 128 bytes a pixel), off, or auto:
+    /// 64 up to half a megapixel, 32 above.
+    #[arg(long, value_name = "SIDE|auto|off", default_value = "auto", value_parser = parse_visibility)]
     pub visibility: Visibility,
     /// Vulkan device to use: part of its name (lavapipe is "llvmpipe").
     #[arg(long, value_name = "NAME")]
@@ -56,17 +57,36 @@ pub struct BakeArgs {
     pub quiet: bool,
 }
 
-/// `--visibility`: a grid, or none.
+/// `--visibility`: a grid, the one the image's size calls for, or none.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Visibility(pub Option<Grid>);
+pub enum Visibility {
+    Side(Grid),
+    Auto,
+    Off,
+}
+
+impl Visibility {
+    /// The grid for a g-buffer of `pixels` pixels.
+    fn grid(self, pixels: usize) -> Option<Grid> {
+        match self {
+            Visibility::Side(grid) => Some(grid),
+            Visibility::Auto => Some(Grid::new(visibility::default_side(pixels)).expect("a default side is a side")),
+            Visibility::Off => None,
+        }
+    }
+}
 
 fn parse_visibility(text: &str) -> std::result::Result<Visibility, String> {
-    if text == "off" {
-        return Ok(Visibility(None));
+    match text {
+        "off" => Ok(Visibility::Off),
+        "auto" => Ok(Visibility::Auto),
+        _ => {
+            let side = text
+                .parse::<u32>()
+                .map_err(|_| format!("'{text}' is not a grid side ({}), auto or off", visibility::side_list()))?;
+            Grid::new(side).map(Visibility::Side)
+        }
     }
-    let side =
-        text.parse::<u32>().map_err(|_| format!("'{text}' is not a grid side ({}) or off", visibility::side_list()))?;
-    Grid::new(side).map(|grid| Visibility(Some(grid)))
 }
 
 /// The flags' values, before anything is read.
@@ -105,12 +125,14 @@ pub fn run(args: BakeArgs) -> Result<()> {
     if !unsupported.is_empty() {
         crate::warn(format!("{}: ignoring unsupported extensions: {}", args.model.display(), unsupported.join(", ")));
     }
+    let (width, height) =
+        (args.size[0].saturating_mul(args.supersample), args.size[1].saturating_mul(args.supersample));
     let options = BakeOptions {
-        width: args.size[0].saturating_mul(args.supersample),
-        height: args.size[1].saturating_mul(args.supersample),
+        width,
+        height,
         samples: args.samples,
         camera,
-        visibility: args.visibility.0,
+        visibility: args.visibility.grid(width as usize * height as usize),
     };
 
     let ctx = crate::gpu::Context::new(&ContextOptions { graphics: true, ..ContextOptions::from_env(args.device) })?;

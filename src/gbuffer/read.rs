@@ -8,7 +8,7 @@ use super::source::{self, Detected, SourceOptions, Surfaces};
 use super::validate;
 use super::GBuffer;
 use crate::input::{self, Kind};
-use crate::visibility::{Grid, DEFAULT_SIDE};
+use crate::visibility::{default_side, Grid};
 use crate::{Error, Result};
 
 /// A g-buffer as read: the validated buffer, what its file was detected as, and the fix-up and
@@ -75,7 +75,8 @@ impl GBuffer {
                 ),
             ));
         };
-        let grid = Grid::new(occluders.side.unwrap_or(DEFAULT_SIDE)).map_err(Error::input)?;
+        let side = occluders.side.unwrap_or_else(|| default_side(read.gbuffer.pixel_count()));
+        let grid = Grid::new(side).map_err(Error::input)?;
         let traced =
             crate::visibility::occluders::trace_positions(&read.gbuffer, path, &positions, &occluders, grid, progress)?;
         read.gbuffer.visibility = Some(traced.visibility);

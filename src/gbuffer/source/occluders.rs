@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 pub struct Occluders {
     /// The glTF file (`.glb` or `.gltf`).
     pub file: PathBuf,
-    /// The visibility grid's side; `None` for [`crate::visibility::DEFAULT_SIDE`].
+    /// The visibility grid's side; `None` for [`crate::visibility::default_side`].
     pub side: Option<u32>,
     /// Where the request came from, for messages: `--occluders`, the header's note.
     pub from: String,
