@@ -633,16 +633,35 @@ emission = [1.0, 0.5, 0.0]
         write(
             "gbuffer",
             "blender-multilayer.exr",
-            &renderer_aovs("ViewLayer.", "Normal", "Position", "CryptoObject", false),
+            &renderer_aovs(&["ViewLayer."], "Normal", "Position", "CryptoObject", false, 0),
         );
-        write("gbuffer", "arnold-multipart.exr", &renderer_aovs("", "N", "P", "crypto_object", true));
+        // A manifest far longer than the image shows, and a copied view layer beside its
+        // original (Blender names it `ViewLayer.002`; read as it is, the two are ambiguous).
+        write(
+            "gbuffer",
+            "blender-long-manifest.exr",
+            &renderer_aovs(&["ViewLayer."], "Normal", "Position", "CryptoObject", false, 2000),
+        );
+        write(
+            "gbuffer",
+            "blender-copied-view-layer.exr",
+            &renderer_aovs(&["ViewLayer.", "ViewLayer.002."], "Normal", "Position", "CryptoObject", false, 0),
+        );
+        write("gbuffer", "arnold-multipart.exr", &renderer_aovs(&[""], "N", "P", "crypto_object", true, 0));
     }
 
     /// A 12×10 disc as a renderer writes it: normals, positions, a Cryptomatte object layer
-    /// with its manifest, and the camera (as lookdev's Blender note, or Arnold's
-    /// worldToCamera); Blender-style (one part, a view layer's prefix) or Arnold-style (an AOV
-    /// a part).
-    fn renderer_aovs(prefix: &str, normal: &str, position: &str, crypto: &str, parts: bool) -> Vec<u8> {
+    /// with its manifest (the disc, then `more` names no pixel shows), and the camera (as
+    /// lookdev's Blender note, or Arnold's worldToCamera); Blender-style (one part, each view
+    /// layer's passes under its prefix) or Arnold-style (an AOV a part, one empty prefix).
+    fn renderer_aovs(
+        prefixes: &[&str],
+        normal: &str,
+        position: &str,
+        crypto: &str,
+        parts: bool,
+        more: usize,
+    ) -> Vec<u8> {
         use exr::prelude::*;
         use lookdev::gbuffer::source::cryptomatte::{hash_to_float, murmur3_32};
         let (w, h) = (12usize, 10usize);
@@ -656,41 +675,53 @@ emission = [1.0, 0.5, 0.0]
         let points: Vec<[f32; 3]> =
             (0..w * h).map(|p| if inside(p) { [p as f32 * 0.01, 0.0, 1.0] } else { [0.0; 3] }).collect();
         let id = hash_to_float(murmur3_32(b"disc"));
-        let vector = |layer: &str, v: &[[f32; 3]], names: [&str; 3]| -> Vec<AnyChannel<FlatSamples>> {
-            (0..3)
-                .map(|k| {
-                    AnyChannel::new(
-                        Text::from(format!("{prefix}{layer}.{}", names[k]).as_str()),
-                        FlatSamples::F32(v.iter().map(|x| x[k]).collect()),
-                    )
-                })
-                .collect()
-        };
-        let rank: Vec<AnyChannel<FlatSamples>> = [
-            (0..w * h).map(|p| if inside(p) { id } else { 0.0 }).collect::<Vec<f32>>(),
-            (0..w * h).map(|p| if inside(p) { 1.0 } else { 0.0 }).collect(),
-            vec![0.0; w * h],
-            vec![0.0; w * h],
-        ]
-        .into_iter()
-        .zip(["r", "g", "b", "a"])
-        .map(|(values, c)| {
-            AnyChannel::new(Text::from(format!("{prefix}{crypto}00.{c}").as_str()), FlatSamples::F32(values))
-        })
-        .collect();
+        let mut manifest = vec![format!("\"disc\":\"{:08x}\"", murmur3_32(b"disc"))];
+        manifest.extend(
+            (0..more).map(|i| format!("\"object{i}\":\"{:08x}\"", murmur3_32(format!("object{i}").as_bytes()))),
+        );
+        let manifest = format!("{{{}}}", manifest.join(","));
+        let suffixes = if parts { ["R", "G", "B"] } else { ["X", "Y", "Z"] };
         let mut attributes = LayerAttributes::default();
-        let layer_name = format!("{prefix}{crypto}");
-        let key = &format!("{:08x}", murmur3_32(layer_name.as_bytes()))[..7];
-        for (field, value) in [
-            ("name", layer_name.clone()),
-            ("hash", "MurmurHash3_32".into()),
-            ("conversion", "uint32_to_float32".into()),
-            ("manifest", format!("{{\"disc\":\"{:08x}\"}}", murmur3_32(b"disc"))),
-        ] {
-            attributes.other.insert(
-                Text::from(format!("cryptomatte/{key}/{field}").as_str()),
-                AttributeValue::Text(Text::from(value.as_str())),
-            );
+        let mut groups = Vec::new();
+        for prefix in prefixes {
+            let vector = |layer: &str, v: &[[f32; 3]]| -> Vec<AnyChannel<FlatSamples>> {
+                (0..3)
+                    .map(|k| {
+                        AnyChannel::new(
+                            Text::from(format!("{prefix}{layer}.{}", suffixes[k]).as_str()),
+                            FlatSamples::F32(v.iter().map(|x| x[k]).collect()),
+                        )
+                    })
+                    .collect()
+            };
+            let rank: Vec<AnyChannel<FlatSamples>> = [
+                (0..w * h).map(|p| if inside(p) { id } else { 0.0 }).collect::<Vec<f32>>(),
+                (0..w * h).map(|p| if inside(p) { 1.0 } else { 0.0 }).collect(),
+                vec![0.0; w * h],
+                vec![0.0; w * h],
+            ]
+            .into_iter()
+            .zip(["r", "g", "b", "a"])
+            .map(|(values, c)| {
+                AnyChannel::new(Text::from(format!("{prefix}{crypto}00.{c}").as_str()), FlatSamples::F32(values))
+            })
+            .collect();
+            let layer_name = format!("{prefix}{crypto}");
+            let key = &format!("{:08x}", murmur3_32(layer_name.as_bytes()))[..7];
+            for (field, value) in [
+                ("name", layer_name.clone()),
+                ("hash", "MurmurHash3_32".into()),
+                ("conversion", "uint32_to_float32".into()),
+                ("manifest", manifest.clone()),
+            ] {
+                attributes.other.insert(
+                    Text::from(format!("cryptomatte/{key}/{field}").as_str()),
+                    AttributeValue::Text(Text::from(value.as_str())),
+                );
+            }
+            groups.push((normal, vector(normal, &n)));
+            groups.push((position, vector(position, &points)));
+            groups.push((crypto, rank));
         }
         if parts {
             attributes.world_to_camera = Some([1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., -5., 1.]);
@@ -698,11 +729,6 @@ emission = [1.0, 0.5, 0.0]
             let note = "lookdev.camera position=0,-5,0 forward=0,1,0 projection=perspective";
             attributes.other.insert(Text::from("Note"), AttributeValue::Text(Text::from(note)));
         }
-        let groups = vec![
-            (normal, vector(normal, &n, if parts { ["R", "G", "B"] } else { ["X", "Y", "Z"] })),
-            (position, vector(position, &points, if parts { ["R", "G", "B"] } else { ["X", "Y", "Z"] })),
-            (crypto, rank),
-        ];
         let layer = |name: Option<&str>, channels: Vec<AnyChannel<FlatSamples>>| {
             let attributes = LayerAttributes { layer_name: name.map(Text::from), ..attributes.clone() };
             Layer::new((w, h), attributes, Encoding::SMALL_LOSSLESS, AnyChannels::sort(channels.into()))

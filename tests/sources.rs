@@ -346,3 +346,71 @@ fn stacks_by_name_resolve_and_lint_reports_two_stacks_claiming_one_object() {
     let warm = moon.iter().filter(|&&p| r[p] > b[p] * 1.3).count();
     assert!(warm * 10 > moon.len() * 9, "the moon is gold at {warm} of {} pixels", moon.len());
 }
+
+/// Blender names a copied view layer `ViewLayer.002`, and its Cryptomatte
+/// `ViewLayer.002.CryptoObject`: reading `ViewLayer` takes `ViewLayer.CryptoObject` alone,
+/// whichever comes first in the file.
+#[test]
+fn a_view_layer_reads_its_own_cryptomatte_and_not_a_copys() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scene();
+    let mut attributes = LayerAttributes::default();
+    let copies = ["ball.copy", "moon.copy"];
+    manifest_attributes(&mut attributes, "ViewLayer.CryptoObject", &OBJECTS);
+    manifest_attributes(&mut attributes, "ViewLayer.002.CryptoObject", &copies);
+    let mut channels = Vec::new();
+    for (layer, names) in [("ViewLayer", OBJECTS), ("ViewLayer.002", copies)] {
+        channels.extend(vector(&format!("{layer}.Normal"), ["X", "Y", "Z"], &s.normal));
+        let object = |p: usize| (s.object[p] > 0).then(|| names[s.object[p] - 1]);
+        channels.extend(crypto_rank(&format!("{layer}.CryptoObject"), object));
+    }
+    let path = dir.path().join("copied.exr");
+    write_layers(&path, vec![layer(None, attributes, channels)]);
+    for (layer, names) in [("ViewLayer", OBJECTS), ("ViewLayer.002", copies)] {
+        let options =
+            SourceOptions { layer: Some(layer.into()), up: Some(lookdev::gbuffer::Up::Y), ..Default::default() };
+        let read = GBuffer::read_with(&path, &options).unwrap();
+        let got: Vec<&str> = read.gbuffer.object_names.values().map(String::as_str).collect();
+        assert_eq!(got, names, "{layer}");
+        assert_eq!(
+            read.gbuffer.coverage.iter().filter(|&&a| a == 1.0).count(),
+            s.object.iter().filter(|&&o| o > 0).count()
+        );
+    }
+}
+
+/// A manifest may name far more entries than the image shows: 100,000 names over a small
+/// image are read in memory that follows the pixels, not the manifest (each entry once took a
+/// whole matte: 6.5 GB at 128×128).
+#[test]
+fn a_huge_cryptomatte_manifest_costs_what_its_pixels_use() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scene();
+    let names: Vec<String> = (0..100_000).map(|i| format!("object{i}")).collect();
+    let mut listed: Vec<&str> = names.iter().map(String::as_str).collect();
+    // The two objects the pixels show are the last in the manifest.
+    listed.extend(OBJECTS);
+    let mut attributes = LayerAttributes::default();
+    manifest_attributes(&mut attributes, "ViewLayer.CryptoObject", &listed);
+    manifest_attributes(&mut attributes, "ViewLayer.CryptoMaterial", &listed);
+    let mut channels = vector("ViewLayer.Normal", ["X", "Y", "Z"], &s.normal);
+    let object = |p: usize| (s.object[p] > 0).then(|| OBJECTS[s.object[p] - 1]);
+    channels.extend(crypto_rank("ViewLayer.CryptoObject", object));
+    channels.extend(crypto_rank("ViewLayer.CryptoMaterial", object));
+    write_layers(&dir.path().join("manifest.exr"), vec![layer(None, attributes, channels)]);
+    let args =
+        ["render", "--gbuffer", "manifest.exr", "--up", "y", "--spp", "1", "--out", "x.exr", "--aov", "objectId"];
+    let run = common::cli::lookdev_measured(dir.path(), &args, 120.0, Some(2048));
+    assert!(run.output.status.success(), "{}", common::cli::stderr(&run.output));
+    // Two mattes of 48×36 pixels, not 100,002 of each layer; the rest is the renderer's own.
+    // Measured: 159 MiB; 817 MiB with a matte per manifest entry.
+    assert!(run.peak_mib < 400.0, "peak {:.0} MiB", run.peak_mib);
+    let read = GBuffer::read_with(
+        &dir.path().join("manifest.exr"),
+        &SourceOptions { up: Some(lookdev::gbuffer::Up::Y), ..Default::default() },
+    )
+    .unwrap();
+    assert_eq!(read.gbuffer.masks.len(), 2, "{:?}", read.gbuffer.masks.keys().collect::<Vec<_>>());
+    let ids: std::collections::BTreeSet<u32> = read.gbuffer.object_id.iter().copied().collect();
+    assert_eq!(ids, [0, 100_001, 100_002].into_iter().collect());
+}

@@ -31,6 +31,9 @@ pub(crate) struct RawImage {
     pub surfaces: super::source::Surfaces,
     /// The supersampling factor the file declares, as written, and where.
     pub supersample: Option<(String, &'static str)>,
+    /// The normals are a renderer's filtered pass: averaged over each pixel's surfaces, which
+    /// at an edge, a crease or a thin part seen edge-on can all but cancel.
+    pub filtered_normals: bool,
 }
 
 /// A normal shorter than this is "clearly empty": it marks background in files without `A`, and
@@ -74,7 +77,7 @@ impl Checker<'_> {
             Some(samples) => self.object_ids(samples)?,
             None => vec![0; raw_normal.len()],
         };
-        let normal = self.normals(&raw_normal, &coverage, has_explicit_coverage, &object_id)?;
+        let normal = self.normals(&raw_normal, &coverage, has_explicit_coverage, &object_id, raw.filtered_normals)?;
         let view = match &raw_view {
             Some(raw_view) => self.views(raw_view)?,
             None => vec![Vec3::from(DEFAULT_VIEW); normal.len()],
@@ -223,12 +226,20 @@ impl Checker<'_> {
     }
 
     /// Unit normals. Covered pixels must have a usable normal; uncovered ones keep theirs where
-    /// it is usable and get the placeholder otherwise.
-    /// Unit normals. A covered pixel's normal shorter than [`MIN_NORMAL_LENGTH`] is an error,
-    /// but where the pixel borders another object: a renderer's filtered normal pass averages
-    /// the two objects' normals there, which can all but cancel. Such a pixel takes the normal of
-    /// a neighbour of its own object (of any covered neighbour if it has none), with a warning.
-    fn normals(&mut self, raw: &[Vec3], coverage: &[f32], explicit_coverage: bool, ids: &[u32]) -> Result<Vec<Vec3>> {
+    /// it is usable and get the placeholder otherwise. A covered pixel's normal shorter than
+    /// [`MIN_NORMAL_LENGTH`] is an error, but where the pixel borders another object, or
+    /// anywhere in a renderer's `filtered` pass: a filtered normal averages the pixel's
+    /// surfaces, whose normals can all but cancel where objects meet, at a crease or on a thin
+    /// part seen edge-on. Such a pixel takes the normal of a neighbour of its own object (of any
+    /// covered neighbour if it has none), with a warning.
+    fn normals(
+        &mut self,
+        raw: &[Vec3],
+        coverage: &[f32],
+        explicit_coverage: bool,
+        ids: &[u32],
+        filtered: bool,
+    ) -> Result<Vec<Vec3>> {
         let mut non_finite = Offenders::default();
         let mut too_short = Offenders::default();
         let mut filled = 0usize;
@@ -242,7 +253,7 @@ impl Checker<'_> {
                 if !n.is_finite() {
                     non_finite.add(i);
                 } else if !usable(n) {
-                    match self.edge_normal(i, raw, coverage, ids) {
+                    match self.edge_normal(i, raw, coverage, ids, filtered) {
                         Some(borrowed) => {
                             normal = borrowed;
                             filled += 1;
@@ -256,8 +267,9 @@ impl Checker<'_> {
             normals.push(normal);
         }
         if filled > 0 {
+            let place = if filtered { "at edges, creases or thin parts" } else { "where objects meet" };
             self.warn(format!(
-                "{} shorter than {MIN_NORMAL_LENGTH} where objects meet (a filtered normal pass averages their \
+                "{} shorter than {MIN_NORMAL_LENGTH} {place} (a filtered normal pass averages the surfaces' \
                  normals there) took a neighbour's normal",
                 counted(filled, "normal")
             ));
@@ -287,11 +299,12 @@ impl Checker<'_> {
         Ok(normals)
     }
 
-    /// Where covered pixel `i` borders another object, the unit normal of a neighbour of its own
-    /// object, else of any covered neighbour, with a usable normal.
-    fn edge_normal(&self, i: usize, raw: &[Vec3], coverage: &[f32], ids: &[u32]) -> Option<Vec3> {
+    /// Where covered pixel `i` borders another object (anywhere, in a `filtered` pass), the unit
+    /// normal of a neighbour of its own object, else of any covered neighbour, with a usable
+    /// normal.
+    fn edge_normal(&self, i: usize, raw: &[Vec3], coverage: &[f32], ids: &[u32], filtered: bool) -> Option<Vec3> {
         let covered: Vec<usize> = self.neighbours(i, raw.len()).filter(|&j| coverage[j] > 0.0).collect();
-        if covered.iter().all(|&j| ids[j] == ids[i]) {
+        if !filtered && covered.iter().all(|&j| ids[j] == ids[i]) {
             return None;
         }
         let usable = |&&j: &&usize| raw[j].is_finite() && raw[j].length() > MIN_NORMAL_LENGTH;
@@ -585,6 +598,7 @@ mod tests {
             mask_names: BTreeMap::new(),
             surfaces: Default::default(),
             supersample: None,
+            filtered_normals: false,
         }
     }
 
@@ -659,6 +673,24 @@ mod tests {
             message.contains("normals shorter than 0.5 where coverage A > 0, at 1 pixel (first at x=1, y=0)"),
             "{message}"
         );
+    }
+
+    /// A renderer's filtered pass averages a crease's or a thin part's two sides inside one
+    /// object (DamagedHelmet rendered by Blender at 320×240 has two such pixels): they take a
+    /// neighbour's normal too; a pixel with no usable neighbour stays an error.
+    #[test]
+    fn short_normals_of_a_filtered_pass_take_a_neighbours_inside_one_object_too() {
+        let mut raw = short_middle_normal([2, 2, 2]);
+        raw.filtered_normals = true;
+        let (g, warnings) = build(Path::new("g.exr"), raw).unwrap();
+        assert_eq!(g.normal[1], [0.6, 0.0, 0.8]);
+        assert!(warnings[0].contains("1 normal shorter than 0.5 at edges, creases or thin parts"), "{}", warnings[0]);
+        let mut raw = short_middle_normal([2, 2, 2]);
+        raw.filtered_normals = true;
+        for axis in ["N.X", "N.Y", "N.Z"] {
+            raw.channels.insert(axis.into(), Samples::F32(vec![0.0, 0.0, 0.1]));
+        }
+        assert!(error_of(raw).contains("normals shorter than 0.5 where coverage A > 0, at 3 pixels"));
     }
 
     #[test]

@@ -122,10 +122,24 @@ pub fn ranks<'a>(channels: &'a BTreeMap<String, &'a Samples>, layer: &str) -> Ve
     out
 }
 
-/// Per pixel: the coverage of each manifest entry, from every rank's (id, coverage) pairs.
+/// The coverage of the manifest entries that cover some pixel, from every rank's (id, coverage)
+/// pairs. Memory follows the pairs the pixels hold, not the manifest's length: a manifest may
+/// name far more entries than the image shows.
 pub struct Decoded {
-    /// Coverage per manifest entry (in manifest order), per pixel.
-    pub mattes: Vec<Vec<f32>>,
+    /// Each entry that covers a pixel, in manifest order: its index in the manifest, and its
+    /// (pixel, coverage) pairs in pixel order, one per pixel.
+    pub mattes: Vec<(usize, Vec<(u32, f32)>)>,
+}
+
+impl Decoded {
+    /// An entry's coverage of every pixel.
+    pub fn dense(pairs: &[(u32, f32)], pixels: usize) -> Vec<f32> {
+        let mut matte = vec![0.0f32; pixels];
+        for &(p, coverage) in pairs {
+            matte[p as usize] = coverage;
+        }
+        matte
+    }
 }
 
 /// Decodes a layer's ranks into the coverage of each manifest entry. Ids that are in no
@@ -133,7 +147,7 @@ pub struct Decoded {
 pub fn decode(declared: &Declared, ranks: &[[&Samples; 4]], pixels: usize) -> Decoded {
     let index: HashMap<u32, usize> =
         declared.manifest.iter().enumerate().map(|(i, (_, hash))| (hash_to_float(*hash).to_bits(), i)).collect();
-    let mut mattes = vec![vec![0.0f32; pixels]; declared.manifest.len()];
+    let mut found: HashMap<usize, Vec<(u32, f32)>> = HashMap::new();
     for quad in ranks {
         let [r, g, b, a] = quad.map(|s| s.as_f32());
         for (ids, coverages) in [(&r, &g), (&b, &a)] {
@@ -141,11 +155,25 @@ pub fn decode(declared: &Declared, ranks: &[[&Samples; 4]], pixels: usize) -> De
                 if let Some(&entry) = index.get(&ids[p].to_bits()) {
                     let coverage = coverages[p];
                     if coverage.is_finite() && coverage > 0.0 {
-                        mattes[entry][p] += coverage;
+                        found.entry(entry).or_default().push((p as u32, coverage));
                     }
                 }
             }
         }
+    }
+    let mut mattes: Vec<(usize, Vec<(u32, f32)>)> = found.into_iter().collect();
+    mattes.sort_unstable_by_key(|(entry, _)| *entry);
+    for (_, pairs) in &mut mattes {
+        // An entry twice in one pixel (in two ranks) covers it by the sum, added in rank order
+        // (the sort is stable).
+        pairs.sort_by_key(|&(p, _)| p);
+        pairs.dedup_by(|later, kept| {
+            let same = later.0 == kept.0;
+            if same {
+                kept.1 += later.1;
+            }
+            same
+        });
     }
     Decoded { mattes }
 }
@@ -233,7 +261,8 @@ mod tests {
         let ranks = ranks(&channels, "L.CryptoObject");
         assert_eq!(ranks.len(), 1);
         let decoded = decode(&layers[0], &ranks, 2);
-        assert_eq!(decoded.mattes, vec![vec![1.0, 0.3], vec![0.0, 0.6]]);
+        assert_eq!(decoded.mattes, vec![(0, vec![(0, 1.0), (1, 0.3)]), (1, vec![(1, 0.6)])]);
+        assert_eq!(Decoded::dense(&decoded.mattes[1].1, 2), vec![0.0, 0.6]);
 
         text.insert("cryptomatte/542cafa/manifest".to_string(), r#"{"Sphere":"e5e9b0dz"}"#.into());
         assert!(declared(&text).unwrap_err().contains("not hexadecimal: 'e5e9b0dz'"));

@@ -28,6 +28,10 @@ use super::{COVERAGE_CHANNEL, MAP_PREFIX, MASK_PREFIX, NORMAL_CHANNELS, OBJECT_I
 use super::{TANGENT_CHANNELS, VIEW_CHANNELS};
 use crate::{Error, Result};
 
+/// The most the mattes of one Cryptomatte layer may take as mask channels (as much as a
+/// g-buffer's channels may take decoded).
+const MAX_MATTE_BYTES: u64 = 4 << 30;
+
 /// The world's up axis in a file.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Up {
@@ -425,6 +429,7 @@ fn lookdev(merged: Merged, options: &SourceOptions) -> (RawImage, Detected, Vec<
         mask_names,
         surfaces: Surfaces::default(),
         supersample,
+        filtered_normals: false,
     };
     let detected = Detected { source: Source::Lookdev, layer: merged.part, up, from: Vec::new() };
     (raw, detected, Vec::new())
@@ -498,7 +503,11 @@ fn other(
     let mut mask_names = BTreeMap::new();
     let mut coverage: Option<Vec<f32>> = None;
     let mut taken: Vec<String> = Vec::new();
-    let in_layer = |d: &&cryptomatte::Declared| prefix.is_empty() || d.name.starts_with(&prefix);
+    // A view layer's own Cryptomatte: `ViewLayer.CryptoObject` is `ViewLayer`'s, not
+    // `ViewLayer.002`'s `ViewLayer.002.CryptoObject`.
+    let in_layer = |d: &&cryptomatte::Declared| {
+        prefix.is_empty() || d.name.strip_prefix(&prefix).is_some_and(|rest| !rest.contains('.'))
+    };
     for declared in crypto.iter().filter(in_layer) {
         let decoded = {
             let refs: BTreeMap<String, &Samples> = channels.iter().map(|(k, v)| (k.clone(), v)).collect();
@@ -519,7 +528,7 @@ fn other(
                 "{}: Cryptomatte layer {}: the manifest's hashes of {} are not MurmurHash3_32 of the names; they are read by the manifest's hashes",
                 path.display(),
                 declared.name,
-                mismatched.join(", ")
+                listed(&mismatched, 5)
             ));
         }
         match declared.role() {
@@ -537,22 +546,30 @@ fn other(
             }
             Role::Object => {}
             _ => {
-                let mut count = 0;
-                for ((name, _), matte) in declared.manifest.iter().zip(decoded.mattes) {
-                    if matte.iter().all(|&c| c == 0.0) {
-                        continue;
-                    }
+                let bytes = (decoded.mattes.len() * pixels * std::mem::size_of::<f32>()) as u64;
+                if bytes > MAX_MATTE_BYTES {
+                    return Err(bad(format!(
+                        "Cryptomatte layer {} covers its pixels with {} names, whose mattes would take {:.1} GiB, \
+                         more than the {} GiB lookdev allows",
+                        declared.name,
+                        decoded.mattes.len(),
+                        bytes as f64 / (1u64 << 30) as f64,
+                        MAX_MATTE_BYTES >> 30
+                    )));
+                }
+                for (entry, pairs) in &decoded.mattes {
+                    let name = &declared.manifest[*entry].0;
                     let mask = crate::asset::names::unique(crate::asset::channel_name(name), &mut taken, |a, b| a == b);
                     if &mask != name {
                         mask_names.insert(mask.clone(), name.clone());
                     }
+                    let matte = cryptomatte::Decoded::dense(pairs, pixels);
                     out.insert(
                         format!("{MASK_PREFIX}{mask}"),
                         Samples::F32(matte.into_iter().map(|c| c.min(1.0)).collect()),
                     );
-                    count += 1;
                 }
-                from.push(("masks".into(), format!("{} ({count} mattes)", declared.name)));
+                from.push(("masks".into(), format!("{} ({} mattes)", declared.name, decoded.mattes.len())));
             }
         }
     }
@@ -688,26 +705,36 @@ fn other(
         mask_names,
         surfaces,
         supersample,
+        filtered_normals: true,
     };
     Ok((raw, Detected { source, layer, up, from }))
 }
 
 /// Per pixel, the manifest entry with the most coverage (numbered from 1 in manifest order, 0
 /// where none covers it), and the coverage of all entries together.
-fn dominant(mattes: &[Vec<f32>], pixels: usize) -> (Vec<u32>, Vec<f32>) {
+fn dominant(mattes: &[(usize, Vec<(u32, f32)>)], pixels: usize) -> (Vec<u32>, Vec<f32>) {
     let mut ids = vec![0u32; pixels];
     let mut sum = vec![0.0f32; pixels];
     let mut best = vec![0.0f32; pixels];
-    for (entry, matte) in mattes.iter().enumerate() {
-        for p in 0..pixels {
-            sum[p] += matte[p];
-            if matte[p] > best[p] {
-                best[p] = matte[p];
-                ids[p] = entry as u32 + 1;
+    for (entry, pairs) in mattes {
+        for &(p, coverage) in pairs {
+            let p = p as usize;
+            sum[p] += coverage;
+            if coverage > best[p] {
+                best[p] = coverage;
+                ids[p] = *entry as u32 + 1;
             }
         }
     }
     (ids, sum)
+}
+
+/// The first `most` names, and how many more there are.
+fn listed(names: &[&str], most: usize) -> String {
+    match names.len().checked_sub(most) {
+        Some(more) if more > 0 => format!("{} and {more} more", names[..most].join(", ")),
+        _ => names.join(", "),
+    }
 }
 
 fn describe_vector(layer: &str, up: Up) -> String {
