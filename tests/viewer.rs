@@ -452,6 +452,30 @@ fn unsaved_edits_are_asked_about_before_closing() {
     assert_eq!(saved.stack_for(1).unwrap().layers[1].params.get(Param::Roughness), Value::Scalar(0.45));
 }
 
+/// A script that raises the unsaved-edits question and does not answer it on the next line
+/// stops with an error at the line that raised it, rather than waiting for an answer nobody
+/// can give: by `quit`, by `open-look` with more lines after it, and by a key. A key's question
+/// answered on the next line is answered.
+#[test]
+fn a_question_the_script_does_not_answer_is_an_error_at_its_line() {
+    let Some(case) = Case::new() else { return };
+    case.write("other.toml", "[[object]]\n[[object.layer]]\npreset = \"chrome\"\n");
+    for script in [
+        "select 1 1\nset roughness 0.37\nquit\n",
+        "select 1 1\nset roughness 0.37\nopen-look other.toml\nset roughness 0.5\n",
+        "select 1 1\nset roughness 0.37\nkey ctrl+Q\n",
+    ] {
+        case.write("ask.script", script);
+        let output = case.view(&["look.toml", "--script", "ask.script"]);
+        let text = stderr(&output);
+        assert_eq!(output.status.code(), Some(2), "{script}: {text}");
+        assert!(text.contains("ask.script:3: ") && text.contains("answer discard"), "{script}: {text}");
+        assert_eq!(text.trim().lines().count(), 1, "{text}");
+    }
+    case.write("answered.script", "select 1 1\nset roughness 0.37\nkey ctrl+Q\nanswer discard\n");
+    assert_success(&case.view(&["look.toml", "--script", "answered.script"]));
+}
+
 #[test]
 fn saving_never_corrupts_an_existing_look() {
     let Some(case) = Case::new() else { return };

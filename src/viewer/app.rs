@@ -146,6 +146,8 @@ struct Running {
     script: Option<ScriptRunner>,
     queue: Vec<(Origin, Action)>,
     pending: Option<Pending>,
+    /// The line and frame of the script's last key press, whose actions come a frame later.
+    scripted_key: Option<(usize, u64)>,
     screenshots: Vec<PathBuf>,
     exit_after_spp: Option<u32>,
     final_screenshot: Option<PathBuf>,
@@ -210,6 +212,7 @@ impl Running {
             script: options.script.clone().map(ScriptRunner::new),
             queue: Vec::new(),
             pending: None,
+            scripted_key: None,
             screenshots: Vec::new(),
             exit_after_spp: options.exit_after_spp,
             final_screenshot: options.screenshot.clone(),
@@ -336,6 +339,11 @@ impl Running {
     /// Queues the script's next action, unless it is waiting for samples.
     fn script_step(&mut self) -> Result<()> {
         let Some(runner) = &mut self.script else { return Ok(()) };
+        // A key pressed last frame acts in this one's interface: its question, if it raises
+        // one, comes before the script's next line, which may answer it.
+        if self.scripted_key.is_some_and(|(_, frame)| self.clock.frames <= frame + 1) {
+            return Ok(());
+        }
         // Under a noise threshold, a wait for samples ends once every pixel has stopped.
         let samples = if self.session.converged() { u32::MAX } else { self.session.samples() };
         let Some((line, step)) = runner.next(samples, self.session.target())? else {
@@ -358,7 +366,22 @@ impl Running {
     fn perform(&mut self, origin: Origin, action: Action) -> Result<()> {
         let scripted_pick =
             matches!((origin, &action), (Origin::Script(_), Action::Pick { .. } | Action::ShowInspection));
+        if let (Origin::Script(line), Action::Key(..)) = (origin, &action) {
+            self.scripted_key = Some((line, self.clock.frames));
+        }
+        let asked_before = self.pending.is_some();
         let outcome = self.try_perform(action);
+        if let (false, true, Some(runner)) = (asked_before, self.pending.is_some(), &self.script) {
+            // A question the script raised, by a line or by a key it pressed (which the
+            // interface answers within the next frames), must be answered by the script.
+            match (origin, self.scripted_key) {
+                (Origin::Script(line), _) => runner.check_answerable(line)?,
+                (Origin::Interface, Some((line, frame))) if self.clock.frames <= frame + 2 => {
+                    runner.check_answerable(line)?
+                }
+                _ => {}
+            }
+        }
         if let (true, Ok(_), Some(pixel)) = (scripted_pick, &outcome, &self.session.inspection) {
             println!("lookdev: {pixel}");
         }

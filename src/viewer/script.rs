@@ -101,6 +101,22 @@ impl ScriptRunner {
         ScriptRunner { script, next: 0 }
     }
 
+    /// An error while a question that `line` raised is open (the unsaved-edits question of
+    /// `quit`, `open-look` or a key), unless the script's next step answers it: a script cannot
+    /// answer later, and nobody else may be there to, so waiting would hang.
+    pub fn check_answerable(&self, line: usize) -> Result<()> {
+        match self.script.steps.get(self.next) {
+            Some((_, Step::Do(Action::Answer(_)))) => Ok(()),
+            _ => Err(self.error_at(
+                line,
+                Error::input(
+                    "this leaves the look's unsaved edits in question: answer on the next line \
+                     (answer save, answer discard or answer cancel)",
+                ),
+            )),
+        }
+    }
+
     pub fn finished(&self) -> bool {
         self.next >= self.script.steps.len()
     }
