@@ -89,6 +89,10 @@ pub struct SheetArgs {
     pub quiet: bool,
 }
 
+/// The most columns a sheet may have (`--columns`): 64 renders of 2048 pixels make a PNG
+/// 131,072 pixels wide, PNG's practical limit.
+const MAX_COLUMNS: usize = 64;
+
 pub fn run(args: PresetsArgs) -> Result<()> {
     match args.command {
         PresetsCommand::List { tag } => list(tag.as_deref()),
@@ -256,6 +260,9 @@ fn sheet(args: SheetArgs) -> Result<()> {
     if !(16..=2048).contains(&args.size) {
         return Err(Error::input(format!("--size {}: renders must be 16 to 2048 pixels", args.size)));
     }
+    if let Some(columns) = args.columns.filter(|c| !(1..=MAX_COLUMNS).contains(c)) {
+        return Err(Error::input(format!("--columns {columns}: a sheet has 1 to {MAX_COLUMNS} columns")));
+    }
     let presets = presets_with_tag(args.tag.as_deref())?;
     // The default look's light, unless another environment is given.
     let mut base = Look::builtin_default();
@@ -286,7 +293,7 @@ fn sheet(args: SheetArgs) -> Result<()> {
     };
     drop(ctx);
     super::check_validation(&counter)?;
-    let columns = args.columns.unwrap_or_else(|| (cells.len() as f64).sqrt().ceil() as usize).max(1);
+    let columns = args.columns.unwrap_or_else(|| (cells.len() as f64).sqrt().ceil() as usize).clamp(1, MAX_COLUMNS);
     let image = sheet::grid(&cells, columns);
     crate::render::output::write_png_image(&args.out, &image)
 }

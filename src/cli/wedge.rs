@@ -12,6 +12,9 @@ use crate::{Error, Result};
 use clap::Args;
 use std::path::PathBuf;
 
+/// The most values a wedge renders a row of (`--values`).
+const MAX_VALUES: usize = 64;
+
 #[derive(Args, Debug)]
 pub struct WedgeArgs {
     /// The parameter to vary, or "all" for one row per parameter.
@@ -80,6 +83,12 @@ pub fn run(args: WedgeArgs) -> Result<()> {
         })?],
     };
     let values = if args.values.is_empty() { (0..=10).map(|i| i as f32 / 10.0).collect() } else { args.values.clone() };
+    if values.len() > MAX_VALUES {
+        return Err(Error::input(format!(
+            "--values: {} values, more than the {MAX_VALUES} a wedge shows",
+            values.len()
+        )));
+    }
     for &param in &params {
         for &v in &values {
             let value = if param.is_color() { Value::Color([v; 3]) } else { Value::Scalar(v) };
