@@ -59,6 +59,37 @@ fn material(roughness: f32, anisotropic: f32) -> Params {
     Params { roughness, anisotropic, base_color: [1.0; 3], metallic: 1.0, ..Params::default() }
 }
 
+/// GTR at the ends of `gtr_gamma`'s documented range and the smoothest roughness, where its
+/// normalisation and power leave a float's range (γ ≥ 8 at roughness 0.05 once gave NaN):
+/// finite, positive, and still normalised.
+#[test]
+fn gtr_is_finite_and_normalised_across_its_whole_range() {
+    let (lo, hi) = lookdev::shading::model::GTR_GAMMA_RANGE;
+    for gamma in [lo, 1.0, 7.0, 8.0, hi] {
+        let m = model(&format!("specular_d=gtr gtr_gamma={gamma}"));
+        for roughness in [0.0, 0.02, 0.05, 0.3, 1.0] {
+            let s = lobes(&material(roughness, 0.0), &m);
+            for theta in [0.0f32, 1e-4, 0.01, 0.5, 1.2, 1.56] {
+                let d = specular_d(&s, Vec3::new(theta.sin(), 0.0, theta.cos()));
+                assert!(d.is_finite() && d >= 0.0, "γ {gamma}, roughness {roughness}, θh {theta}: D = {d}");
+            }
+            // Isotropic: ∫D·cosθh dω over ln tanθh, which resolves both a peak as narrow as α
+            // (γ = 10) and a tail that holds most of the mass (γ = 0.5).
+            let steps = 4000;
+            let (lo, hi) = (-16.0f64, 10.0f64);
+            let total: f64 = (0..steps)
+                .map(|i| {
+                    let theta = (lo + (hi - lo) * (i as f64 + 0.5) / steps as f64).exp().atan();
+                    let h = Vec3::new(theta.sin() as f32, 0.0, theta.cos() as f32);
+                    let jacobian = theta.sin() * theta.cos() * (hi - lo) / steps as f64;
+                    specular_d(&s, h) as f64 * theta.cos() * theta.sin() * jacobian * 2.0 * std::f64::consts::PI
+                })
+                .sum();
+            assert!((total - 1.0).abs() < 2e-3, "γ {gamma}, roughness {roughness}: ∫D·cosθh = {total}");
+        }
+    }
+}
+
 #[test]
 fn every_distribution_is_normalised() {
     for text in [
@@ -403,4 +434,56 @@ fn switching_models_never_changes_the_default_render() {
     assert!(switched.shading().model.specular_d == SpecularD::Gtr2);
     drop(switched);
     common::gpu::finish(ctx);
+}
+
+/// The same ends of the range through the commands: a render of a mirror-smooth GTR-10
+/// material, and the albedo table of GTR-10, are finite (they once exited 1 as a defect, and
+/// wrote NaN into every row).
+#[test]
+fn gtr_at_the_end_of_its_range_renders_and_plots_finite_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("gtr.exr");
+    let render = common::cli::lookdev(&[
+        "render",
+        "--model",
+        "specular_d=gtr",
+        "--model",
+        "gtr_gamma=10",
+        "--set",
+        "roughness=0",
+        "--size",
+        "48",
+        "48",
+        "--spp",
+        "8",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    common::cli::assert_success(&render);
+    let image = exr::prelude::read_all_flat_layers_from_file(&out).unwrap();
+    for channel in &image.layer_data[0].channel_data.list {
+        assert!(channel.sample_data.values_as_f32().all(f32::is_finite), "{:?}", channel.name);
+    }
+    let svg = dir.path().join("albedo.svg");
+    let albedo = common::cli::lookdev(&[
+        "brdf",
+        "albedo",
+        "--model",
+        "specular_d=gtr",
+        "--model",
+        "gtr_gamma=10",
+        "--set",
+        "roughness=0",
+        "--out",
+        svg.to_str().unwrap(),
+    ]);
+    common::cli::assert_success(&albedo);
+    let text = std::fs::read_to_string(dir.path().join("albedo.csv")).unwrap();
+    let rows: Vec<&str> = text.lines().skip(1).collect();
+    assert!(rows.len() > 2, "{text}");
+    for row in rows {
+        let values: Vec<f32> = row.split(',').skip(1).map(|v| v.parse().unwrap()).collect();
+        assert!(values.iter().all(|v| v.is_finite()), "{row}");
+    }
 }

@@ -36,7 +36,7 @@ struct Lobes {
     float ay;
     float gx;             // alphas of the shadowing term: ax, ay, or the 2012 notes' remap
     float gy;
-    float d_norm;         // GTR-γ normalisation
+    float d_log_norm;     // ln of the GTR-γ normalisation
     float clearcoat;      // 0.25 · clearcoat: the clearcoat lobe's weight in the total
     float cc_alpha2;      // GTR1 alpha², at most 1
     float cc_log2_alpha2; // for sampling GTR1
@@ -72,17 +72,22 @@ float log_accurate(float x) {
     return abs(x - 1.0) < 0.05 ? log1p_accurate(x - 1.0) : log(x);
 }
 
-// GTR normalisation for exponent γ (Burley 2012, appendix B): (γ−1)(α²−1)/(π(1 − α^(2(1−γ)))),
-// the γ → 1 limit (α²−1)/(π ln α²), and 1/π for α ≥ 1 (a uniform distribution).
-float gtr_norm(float alpha2, float gamma) {
+// ln of GTR's normalisation for exponent γ (Burley 2012, appendix B): (γ−1)(α²−1)/(π(1 −
+// α^(2(1−γ)))), the γ → 1 limit (α²−1)/(π ln α²), and 1/π for α ≥ 1. A logarithm, because
+// α^(2(1−γ)) overflows a float at the ends of the range (e^124 at γ = 10, α = 0.001) where the
+// distribution itself is finite.
+float gtr_log_norm(float alpha2, float gamma) {
     if (alpha2 >= 1.0) {
-        return INV_PI;
+        return -log(PI);
     }
     float log_alpha2 = log_accurate(alpha2);
     if (abs(gamma - 1.0) < 1e-4) {
-        return (alpha2 - 1.0) / (PI * log_alpha2);
+        return log((alpha2 - 1.0) / log_alpha2) - log(PI);
     }
-    return (gamma - 1.0) * (alpha2 - 1.0) / (PI * -expm1_accurate((1.0 - gamma) * log_alpha2));
+    float l = (1.0 - gamma) * log_alpha2;
+    // ln|e^l − 1|; for l > 0, l + ln(1 − e^−l), which cannot overflow.
+    float log_expm1 = l > 0.0 ? l + log(-expm1_accurate(-l)) : log(-expm1_accurate(l));
+    return log(abs(gamma - 1.0) * (1.0 - alpha2)) - log(PI) - log_expm1;
 }
 
 // n and k of the complex IOR whose normal reflectance is r and whose edge parameter is e: n runs
@@ -152,13 +157,13 @@ Lobes make_lobes(Material m) {
     float r2 = m.roughness * m.roughness;
     s.ax = max(0.001, r2 / aspect);
     s.ay = max(0.001, r2 * aspect);
-    s.d_norm = 0.0;
+    s.d_log_norm = 0.0;
     if (MODEL_SPECULAR_D == SPECULAR_D_GTR) {
         // GTR with γ ≠ 2 does not keep its shape when stretched, so it is isotropic.
         float a = sqrt(s.ax * s.ay);
         s.ax = a;
         s.ay = a;
-        s.d_norm = gtr_norm(a * a, MODEL_GTR_GAMMA);
+        s.d_log_norm = gtr_log_norm(a * a, MODEL_GTR_GAMMA);
     }
     s.gx = s.ax;
     s.gy = s.ay;
@@ -219,9 +224,10 @@ float gtr2_aniso(vec3 h, float ax, float ay) {
     return 1.0 / (PI * ax * ay * d * d);
 }
 
-// GTR with exponent γ, isotropic: c/(α²·cos²θh + sin²θh)^γ.
-float gtr_gamma(vec3 h, float alpha2, float norm, float gamma) {
-    return norm / pow(alpha2 * h.z * h.z + h.x * h.x + h.y * h.y, gamma);
+// GTR with exponent γ, isotropic: c/(α²·cos²θh + sin²θh)^γ, from ln c, in logarithms (both c
+// and the power leave a float's range at the ends of γ's).
+float gtr_gamma(vec3 h, float alpha2, float log_norm, float gamma) {
+    return exp(log_norm - gamma * log(alpha2 * h.z * h.z + h.x * h.x + h.y * h.y));
 }
 
 // Anisotropic Beckmann: exp(−tan²θh·(cos²φ/αx² + sin²φ/αy²))/(π·αx·αy·cos⁴θh).
@@ -242,7 +248,7 @@ float specular_d(Lobes s, vec3 h) {
         return beckmann_aniso(h, s.ax, s.ay);
     }
     if (MODEL_SPECULAR_D == SPECULAR_D_GTR) {
-        return gtr_gamma(h, s.ax * s.ax, s.d_norm, MODEL_GTR_GAMMA);
+        return gtr_gamma(h, s.ax * s.ax, s.d_log_norm, MODEL_GTR_GAMMA);
     }
     return gtr2_aniso(h, s.ax, s.ay);
 }

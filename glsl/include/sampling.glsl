@@ -85,8 +85,13 @@ vec3 sample_gtr_normal(float alpha2, float gamma, vec2 azimuth, float u) {
         if (abs(gamma - 1.0) < 1e-4) {
             one_minus_s = -expm1_accurate(log_alpha2 * (1.0 - u));
         } else {
+            // ln s = ln((1−u)·e^l + u)/(1−γ); for l > 0 as l + ln(1 + u·(e^−l − 1)), where e^l
+            // would overflow at the ends of γ's range.
             float e = 1.0 - gamma;
-            one_minus_s = -expm1_accurate(log1p_accurate((1.0 - u) * expm1_accurate(e * log_alpha2)) / e);
+            float l = e * log_alpha2;
+            float log_s = (l > 0.0 ? l + log1p_accurate(u * expm1_accurate(-l))
+                                   : log1p_accurate((1.0 - u) * expm1_accurate(l))) / e;
+            one_minus_s = -expm1_accurate(log_s);
         }
         cos2 = one_minus_s / (1.0 - alpha2);
     }

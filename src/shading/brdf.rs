@@ -45,8 +45,8 @@ pub struct Lobes {
     /// Alphas of the shadowing term: ax, ay, or the 2012 notes' remap.
     pub gx: f32,
     pub gy: f32,
-    /// GTR-γ normalisation.
-    pub d_norm: f32,
+    /// ln of the GTR-γ normalisation.
+    pub d_log_norm: f32,
     /// 0.25 · clearcoat: the clearcoat lobe's weight in the total.
     pub clearcoat: f32,
     /// GTR1 alpha², at most 1.
@@ -108,16 +108,22 @@ pub fn log_accurate(x: f32) -> f32 {
     }
 }
 
-/// GTR normalisation for exponent γ (Burley 2012, appendix B).
-pub fn gtr_norm(alpha2: f32, gamma: f32) -> f32 {
+/// ln of GTR's normalisation for exponent γ (Burley 2012, appendix B): (γ−1)(α²−1)/(π(1 −
+/// α^(2(1−γ)))), the γ → 1 limit (α²−1)/(π ln α²), and 1/π for α ≥ 1. A logarithm, because
+/// α^(2(1−γ)) overflows a float at the ends of the range (e^124 at γ = 10, α = 0.001) where the
+/// distribution itself is finite.
+pub fn gtr_log_norm(alpha2: f32, gamma: f32) -> f32 {
     if alpha2 >= 1.0 {
-        return INV_PI;
+        return -PI.ln();
     }
     let log_alpha2 = log_accurate(alpha2);
     if (gamma - 1.0).abs() < 1e-4 {
-        return (alpha2 - 1.0) / (PI * log_alpha2);
+        return ((alpha2 - 1.0) / log_alpha2).ln() - PI.ln();
     }
-    (gamma - 1.0) * (alpha2 - 1.0) / (PI * -expm1_accurate((1.0 - gamma) * log_alpha2))
+    let l = (1.0 - gamma) * log_alpha2;
+    // ln|e^l − 1|; for l > 0, l + ln(1 − e^−l), which cannot overflow.
+    let log_expm1 = if l > 0.0 { l + (-expm1_accurate(-l)).ln() } else { (-expm1_accurate(l)).ln() };
+    ((gamma - 1.0).abs() * (1.0 - alpha2)).ln() - PI.ln() - log_expm1
 }
 
 /// (n, k) of the complex IOR whose normal reflectance is `r` and whose edge parameter is `e`.
@@ -215,12 +221,12 @@ pub fn make_lobes_with(m: impl Into<Material>, shading: &Shading) -> Lobes {
     let r2 = m.roughness * m.roughness;
     let mut ax = (r2 / aspect).max(0.001);
     let mut ay = (r2 * aspect).max(0.001);
-    let mut d_norm = 0.0;
+    let mut d_log_norm = 0.0;
     if model.specular_d == SpecularD::Gtr {
         let a = (ax * ay).sqrt();
         ax = a;
         ay = a;
-        d_norm = gtr_norm(a * a, model.gtr_gamma);
+        d_log_norm = gtr_log_norm(a * a, model.gtr_gamma);
     }
     let (mut gx, mut gy) = (ax, ay);
     if model.specular_g == SpecularG::Burley2012 {
@@ -255,7 +261,7 @@ pub fn make_lobes_with(m: impl Into<Material>, shading: &Shading) -> Lobes {
         ay,
         gx,
         gy,
-        d_norm,
+        d_log_norm,
         clearcoat: 0.25 * m.clearcoat,
         cc_alpha2,
         cc_log2_alpha2: cc_alpha2.log2(),
@@ -295,9 +301,10 @@ pub fn gtr2_aniso(h: Vec3, ax: f32, ay: f32) -> f32 {
     1.0 / (PI * ax * ay * d * d)
 }
 
-/// GTR with exponent γ, isotropic: c/(α²·cos²θh + sin²θh)^γ.
-pub fn gtr_gamma(h: Vec3, alpha2: f32, norm: f32, gamma: f32) -> f32 {
-    norm / (alpha2 * h.z * h.z + h.x * h.x + h.y * h.y).powf(gamma)
+/// GTR with exponent γ, isotropic: c/(α²·cos²θh + sin²θh)^γ, from ln c, in logarithms (both
+/// c and the power leave a float's range at the ends of γ's).
+pub fn gtr_gamma(h: Vec3, alpha2: f32, log_norm: f32, gamma: f32) -> f32 {
+    (log_norm - gamma * (alpha2 * h.z * h.z + h.x * h.x + h.y * h.y).ln()).exp()
 }
 
 /// Anisotropic Beckmann.
@@ -315,7 +322,7 @@ pub fn beckmann_aniso(h: Vec3, ax: f32, ay: f32) -> f32 {
 pub fn specular_d(s: &Lobes, h: Vec3) -> f32 {
     match s.model.specular_d {
         SpecularD::Beckmann => beckmann_aniso(h, s.ax, s.ay),
-        SpecularD::Gtr => gtr_gamma(h, s.ax * s.ax, s.d_norm, s.model.gtr_gamma),
+        SpecularD::Gtr => gtr_gamma(h, s.ax * s.ax, s.d_log_norm, s.model.gtr_gamma),
         SpecularD::Gtr2 => gtr2_aniso(h, s.ax, s.ay),
     }
 }

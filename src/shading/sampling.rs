@@ -81,8 +81,16 @@ pub fn sample_gtr_normal(alpha2: f32, gamma: f32, azimuth: Vec2, u: f32) -> Vec3
         let one_minus_s = if (gamma - 1.0).abs() < 1e-4 {
             -expm1_accurate(log_alpha2 * (1.0 - u))
         } else {
+            // ln s = ln((1−u)·e^l + u)/(1−γ); for l > 0 as l + ln(1 + u·(e^−l − 1)), where e^l
+            // would overflow at the ends of γ's range.
             let e = 1.0 - gamma;
-            -expm1_accurate(log1p_accurate((1.0 - u) * expm1_accurate(e * log_alpha2)) / e)
+            let l = e * log_alpha2;
+            let log_s = if l > 0.0 {
+                l + log1p_accurate(u * expm1_accurate(-l))
+            } else {
+                log1p_accurate((1.0 - u) * expm1_accurate(l))
+            } / e;
+            -expm1_accurate(log_s)
         };
         one_minus_s / (1.0 - alpha2)
     };
