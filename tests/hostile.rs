@@ -372,6 +372,19 @@ fn messages_name_what_is_wrong_and_only_that() {
         200,
     );
 
+    // AOVs cannot go into a PNG: asked for on the command line, an error; in the look, a warning.
+    refused(d, &["render", "--aov", "diffuse", "--out", "x.png"], &["--aov diffuse", "--aov-display NAME"], 200);
+    write(d, "aovs.toml", "[render]\naovs = [\"diffuse\"]\n");
+    succeeds_warning(
+        d,
+        &["render", "--look", "aovs.toml", "--size", "16", "16", "--spp", "1", "--out", "x.png"],
+        &["the look's [render] aovs are not written into a PNG (x.png)"],
+    );
+
+    // A folder given as the environment is called a folder, as formats.md promises.
+    std::fs::create_dir(d.join("envs")).unwrap();
+    refused(d, &["render", "--env", "envs", "--out", "x.png"], &["envs", "not a regular file (a folder)"], 200);
+
     // Names read from files are escaped: no terminal escape or NUL reaches stderr.
     // TOML's own escapes put ESC and NUL into the name.
     write(d, "escape.toml", "[[object]]\n[[object.layer]]\npreset = \"\\u001b[31mred\\u0000\"\n");

@@ -293,7 +293,9 @@ fn ambiguous_and_broken_sources_are_one_line_errors() {
         read.gbuffer.coverage.iter().filter(|&&a| a == 1.0).count(),
         s.object.iter().filter(|&&o| o > 0).count()
     );
-    assert!(read.warnings.iter().any(|w| w.contains("no view vectors")), "{:?}", read.warnings);
+    // In words a reader parses ("no the camera" once read there).
+    let views = "no view vectors, and no positions to make them from (no P or Position layer)";
+    assert!(read.warnings.iter().any(|w| w.contains(views)), "{:?}", read.warnings);
     let out = render(
         &path("other.exr"),
         &["--gbuffer-channel", "normal=Nworld", "--gbuffer-channel", "coverage=alpha", "--quiet"],

@@ -158,6 +158,12 @@ pub fn run(args: RenderArgs) -> Result<()> {
             return Err(Error::input_file(&args.out, "the output folder does not exist"));
         }
     }
+    if format == OutputFormat::Png && !args.aovs.is_empty() {
+        return Err(Error::input(format!(
+            "--aov {}: a PNG holds only the image; write an .exr to keep AOVs, or show one in the PNG with --aov-display NAME",
+            args.aovs.join(" --aov ")
+        )));
+    }
     let mut spec = args.scene.spec(args.look.as_deref(), &args.aovs, args.quiet)?;
     args.adaptive.apply(&mut spec.overrides);
     if let Some(second) = &args.compare {
@@ -173,6 +179,12 @@ pub fn run(args: RenderArgs) -> Result<()> {
         let counter = ctx.validation_counter();
         let device_name = ctx.info().name.clone();
         let aovs = output_aovs(format, display, &scene.settings);
+        if format == OutputFormat::Png && !scene.settings.aovs.is_empty() {
+            crate::warn(format!(
+                "the look's [render] aovs are not written into a PNG ({}): write an .exr to keep them",
+                args.out.display()
+            ));
+        }
         // Only a PNG of the beauty shows the display pixels.
         let beauty_png = format == OutputFormat::Png && display.is_none();
         let rendered =

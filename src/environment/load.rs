@@ -29,7 +29,10 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Environment> {
             exr_environment(&bytes, texels, &name, options)
         }
         Some("hdr") => from_hdr_bytes(&input::read(path, Kind::Environment)?, &name, options),
-        _ => Err(Error::input_file(path, "unsupported environment format: use an equirectangular .exr or .hdr")),
+        _ => {
+            input::check_regular(path)?;
+            Err(Error::input_file(path, "unsupported environment format: use an equirectangular .exr or .hdr"))
+        }
     }
 }
 

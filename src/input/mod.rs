@@ -78,6 +78,18 @@ pub fn read(path: &Path, kind: Kind) -> Result<Vec<u8>> {
     read_bytes(path, kind).map_err(|problem| Error::input_file(path, problem))
 }
 
+/// Checks that `path` is a regular file that can be opened, without reading it: for a caller
+/// that refuses it on other grounds, so that a folder is called a folder first.
+pub fn check_regular(path: &Path) -> Result<()> {
+    let meta = open(path)
+        .and_then(|file| file.metadata().map_err(|e| format!("cannot read the file ({e})")))
+        .map_err(|problem| Error::input_file(path, problem))?;
+    if !meta.is_file() {
+        return Err(Error::input_file(path, not_regular(&meta)));
+    }
+    Ok(())
+}
+
 /// Reads a whole text file of `kind`, which must be UTF-8.
 pub fn read_text(path: &Path, kind: Kind) -> Result<String> {
     let bytes = read(path, kind)?;
@@ -101,7 +113,7 @@ pub fn read_bytes_at_most(path: &Path, kind: Kind, cap: u64) -> std::result::Res
     let file = open(path)?;
     let meta = file.metadata().map_err(|e| format!("cannot read the file ({e})"))?;
     if !meta.is_file() {
-        return Err(format!("not a regular file ({}); lookdev reads only regular files", file_type(&meta)));
+        return Err(not_regular(&meta));
     }
     if meta.len() > cap {
         return Err(too_large(meta.len(), cap, kind));
@@ -130,6 +142,10 @@ fn open(path: &Path) -> std::result::Result<File, String> {
         std::io::ErrorKind::PermissionDenied => "permission denied".to_string(),
         _ => format!("cannot open the file ({e})"),
     })
+}
+
+fn not_regular(meta: &std::fs::Metadata) -> String {
+    format!("not a regular file ({}); lookdev reads only regular files", file_type(meta))
 }
 
 fn too_large(len: u64, cap: u64, kind: Kind) -> String {

@@ -679,12 +679,12 @@ fn other(
             }
             (position, _) => {
                 let missing = if position.is_some() {
-                    "the camera (the header records none; --camera-position X,Y,Z gives it)"
+                    "no camera to make them from (the header records none; --camera-position X,Y,Z gives it)"
                 } else {
-                    "positions (no P or Position layer)"
+                    "no positions to make them from (no P or Position layer)"
                 };
                 warnings.push(format!(
-                    "{}: no view vectors, and no {missing}: V defaults to (0, 0, 1), an orthographic camera looking down -Z",
+                    "{}: no view vectors, and {missing}: V defaults to (0, 0, 1), an orthographic camera looking down -Z",
                     path.display()
                 ));
             }
