@@ -443,41 +443,17 @@ fn switching_models_never_changes_the_default_render() {
 fn gtr_at_the_end_of_its_range_renders_and_plots_finite_values() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("gtr.exr");
-    let render = common::cli::lookdev(&[
-        "render",
-        "--model",
-        "specular_d=gtr",
-        "--model",
-        "gtr_gamma=10",
-        "--set",
-        "roughness=0",
-        "--size",
-        "48",
-        "48",
-        "--spp",
-        "8",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    // A mirror-smooth material under GTR at the top of its range.
+    let gtr = ["--model", "specular_d=gtr", "--model", "gtr_gamma=10", "--set", "roughness=0"];
+    let sized = ["--size", "48", "48", "--spp", "8", "--quiet", "--out", out.to_str().unwrap()];
+    let render = common::cli::lookdev(&[&["render"][..], &gtr, &sized].concat());
     common::cli::assert_success(&render);
     let image = exr::prelude::read_all_flat_layers_from_file(&out).unwrap();
     for channel in &image.layer_data[0].channel_data.list {
         assert!(channel.sample_data.values_as_f32().all(f32::is_finite), "{:?}", channel.name);
     }
     let svg = dir.path().join("albedo.svg");
-    let albedo = common::cli::lookdev(&[
-        "brdf",
-        "albedo",
-        "--model",
-        "specular_d=gtr",
-        "--model",
-        "gtr_gamma=10",
-        "--set",
-        "roughness=0",
-        "--out",
-        svg.to_str().unwrap(),
-    ]);
+    let albedo = common::cli::lookdev(&[&["brdf", "albedo"][..], &gtr, &["--out", svg.to_str().unwrap()]].concat());
     common::cli::assert_success(&albedo);
     let text = std::fs::read_to_string(dir.path().join("albedo.csv")).unwrap();
     let rows: Vec<&str> = text.lines().skip(1).collect();
