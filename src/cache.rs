@@ -34,10 +34,15 @@ pub const MAX_KEY: usize = 4096;
 /// The folder of one kind of cache, `$XDG_CACHE_HOME/lookdev/<name>` (else
 /// `~/.cache/lookdev/<name>`); `None` when neither variable is set. Not created here.
 pub fn folder(name: &str) -> Option<PathBuf> {
-    let base = std::env::var_os("XDG_CACHE_HOME")
+    folder_with(name, |var| std::env::var_os(var))
+}
+
+/// [`folder`], with the environment's variables read through `var`.
+pub fn folder_with(name: &str, var: impl Fn(&str) -> Option<std::ffi::OsString>) -> Option<PathBuf> {
+    let base = var("XDG_CACHE_HOME")
         .filter(|v| !v.is_empty())
         .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").filter(|v| !v.is_empty()).map(|home| Path::new(&home).join(".cache")))?;
+        .or_else(|| var("HOME").filter(|v| !v.is_empty()).map(|home| Path::new(&home).join(".cache")))?;
     Some(base.join("lookdev").join(name))
 }
 

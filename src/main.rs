@@ -4,6 +4,8 @@ use std::sync::Mutex;
 static PANIC_PLACE: Mutex<Option<String>> = Mutex::new(None);
 
 fn main() {
+    // Before any thread starts and before the Vulkan loader opens (see driver_cache).
+    lookdev::gpu::driver_cache::prepare();
     // A panic is reported as one line (see catching_panics), not a trace; RUST_BACKTRACE=1
     // brings the trace back.
     if std::env::var_os("RUST_BACKTRACE").is_none() {

@@ -186,6 +186,40 @@ fn damaged_cache_files_are_ignored_and_made_again() {
     }
 }
 
+/// An entry whose payload hash is right is still checked as strictly as the input it stands
+/// for: NaN in a table once rendered another image, and NaN texels once made lookdev blame the
+/// intact environment file.
+#[test]
+fn crafted_entries_with_a_right_hash_are_checked_like_their_input() {
+    let case = Case::new();
+    let env = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/environment/sunrise.exr");
+    let env = env.to_str().unwrap();
+    // Its few negative texels (from lossy compression) are clamped, on every load.
+    case.render(Some(&case.cache()), "reference.exr", &["--env", env, "--env-clamp"]);
+    let reference = case.pixels("reference.exr");
+    // Replaces the payload's 4 bytes at `at` (from its end) with `value` and fixes the hash.
+    let craft = |file: &Path, from_end: usize, value: f32| {
+        let mut bytes = std::fs::read(file).unwrap();
+        let key = u32::from_le_bytes(bytes[20..24].try_into().unwrap()) as usize;
+        let at = bytes.len() - from_end;
+        bytes[at..at + 4].copy_from_slice(&value.to_le_bytes());
+        let hash = lookdev::cache::hash128(&bytes[48 + key..]);
+        bytes[32..48].copy_from_slice(&hash);
+        std::fs::write(file, bytes).unwrap();
+    };
+    let tables = case.file("environments", ".tables");
+    let texels = case.file("environments", ".texels");
+    assert!(texels.file_name().unwrap().to_string_lossy().starts_with("file-"), "{texels:?}");
+    // The last cell's pdf, and a texel near the end.
+    craft(&tables, 4, f32::NAN);
+    craft(&texels, 40, f32::NAN);
+    let output = case.render(Some(&case.cache()), "crafted.exr", &["--env", env, "--env-clamp"]);
+    assert!(case.pixels("crafted.exr") == reference, "the crafted entries changed the image");
+    assert!(!loaded(&output).1, "the crafted tables are not used: {}", stderr(&output));
+    assert!(!stderr(&output).contains("loaded from"), "nothing crafted is used: {}", stderr(&output));
+    assert!(!stderr(&output).contains("error"), "{}", stderr(&output));
+}
+
 #[test]
 fn a_cache_folder_that_cannot_be_written_does_not_fail_the_render() {
     let case = Case::new();
@@ -194,6 +228,51 @@ fn a_cache_folder_that_cannot_be_written_does_not_fail_the_render() {
     let blocked = case.render(Some(&case.path("not-a-folder")), "blocked.exr", &[]);
     assert!(warnings(&blocked).is_empty(), "{:?}", warnings(&blocked));
     assert!(stderr(&blocked).contains("cache: cannot write"), "timings say why: {}", stderr(&blocked));
-    case.render(None, "none.exr", &[]);
+    assert!(stderr(&blocked).contains("driver shader cache off"), "{}", stderr(&blocked));
+    assert_only_lookdev_speaks(&blocked);
+    let none = case.render(None, "none.exr", &[]);
+    assert_only_lookdev_speaks(&none);
     assert!(case.pixels("blocked.exr") == case.pixels("none.exr"));
+}
+
+/// Every line on stderr is lookdev's own: the driver's ("… for shader cache (not a
+/// directory)---disabling") once reached it where the docs promise silence.
+fn assert_only_lookdev_speaks(output: &Output) {
+    let text = stderr(output);
+    assert!(text.lines().all(|l| l.starts_with("lookdev: ")), "a line that is not lookdev's:\n{text}");
+}
+
+/// A cache folder on a full file system: the driver's shader cache, which maps its files into
+/// memory, once killed every command there with SIGBUS (exit 135, no message). Needs a tmpfs,
+/// so root (as CI runs); elsewhere it says so and passes.
+#[test]
+fn a_full_cache_file_system_does_not_fail_the_render() {
+    let case = Case::new();
+    let full = case.path("full");
+    std::fs::create_dir(&full).unwrap();
+    let mounted = Command::new("mount").args(["-t", "tmpfs", "-o", "size=512k", "tmpfs"]).arg(&full).output();
+    if !mounted.is_ok_and(|o| o.status.success()) {
+        assert!(
+            std::env::var_os("CI").is_none() || unsafe { libc::geteuid() } != 0,
+            "CI runs as root: mount must work"
+        );
+        eprintln!("skipped: cannot mount a tmpfs here");
+        return;
+    }
+    struct Unmount(PathBuf);
+    impl Drop for Unmount {
+        fn drop(&mut self) {
+            let _ = Command::new("umount").arg(&self.0).status();
+        }
+    }
+    let _unmount = Unmount(full.clone());
+    // Fill it to the last byte.
+    let mut filler = std::fs::File::create(full.join("filler")).unwrap();
+    let block = vec![0u8; 4096];
+    while std::io::Write::write_all(&mut filler, &block).is_ok() {}
+    let _ = std::io::Write::write_all(&mut filler, &[0]);
+    drop(filler);
+    let output = case.render(Some(&full), "full.exr", &[]);
+    assert!(stderr(&output).contains("driver shader cache off"), "{}", stderr(&output));
+    assert_only_lookdev_speaks(&output);
 }

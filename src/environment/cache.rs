@@ -69,7 +69,7 @@ pub fn distribution(environment: &Environment, max_image_side: u32, compensated:
         let decoded = decode_tables(&payload, environment.width, environment.height);
         if decoded.is_none() {
             crate::warn(format!(
-                "ignoring the cache file {}: its tables do not fit the map; they are made again",
+                "ignoring the cache file {}: its tables are damaged or do not fit the map; they are made again",
                 path_text(&path)
             ));
         }
@@ -177,15 +177,15 @@ pub fn encode_tables(d: &Distribution) -> Vec<u8> {
     out
 }
 
-/// A table of `n` intervals, checked to be searchable: n + 1 CDF entries and guides within
-/// the table.
+/// A table of `n` intervals, checked as strictly as one built from a map: a CDF from exactly 0
+/// to exactly 1 that never decreases, and the very guides that CDF gives.
 fn read_table(reader: &mut Reader, n: u32) -> Option<Table> {
     if reader.u32()? != n {
         return None;
     }
     let cdf = reader.floats(n as usize + 1)?;
     let guide = reader.words(n as usize + 1)?;
-    guide.iter().all(|&g| g < n).then_some(Table { cdf, guide })
+    Table::from_cdf(cdf).filter(|table| table.guide == guide)
 }
 
 /// The tables [`encode_tables`] wrote, if they are whole and fit a map of `width`×`height`.
@@ -206,6 +206,9 @@ pub fn decode_tables(bytes: &[u8], width: u32, height: u32) -> Option<Distributi
     let marginal = read_table(&mut reader, rows)?;
     let conditional = (0..rows).map(|_| read_table(&mut reader, columns)).collect::<Option<Vec<_>>>()?;
     let cell_pdf = reader.floats((rows * columns) as usize)?;
+    if !cell_pdf.iter().all(|p| p.is_finite() && *p >= 0.0) {
+        return None;
+    }
     reader.bytes.is_empty().then_some(Distribution {
         width,
         height,
@@ -262,14 +265,16 @@ pub fn file_texels(
     let mut key = cache::hash128(bytes).to_vec();
     key.extend_from_slice(&sources_hash());
     let path = folder().map(|f| f.join(format!("file-{}.texels", cache::hex(&cache::hash128(&key)))));
-    if let Some(texels) = path.as_deref().and_then(|path| FILE_TEXELS.load(path, &key)).and_then(|p| decode_texels(&p))
-    {
+    // Texels that are not finite or beyond the bound are never cached (see below), so such an
+    // entry is damaged: the file is decoded again, and only its own problems are reported.
+    let cached = path.as_deref().and_then(|path| FILE_TEXELS.load(path, &key)).and_then(|p| decode_texels(&p));
+    if let Some(texels) = cached.filter(|(_, _, texels)| storable(texels)) {
         crate::timings::note(|| format!("environment: {name} loaded from {}", path_text(&path)));
         cache::touch(path.as_deref());
         return Ok(texels);
     }
     let (width, height, texels) = decode()?;
-    if let Some(path) = &path {
+    if let Some(path) = path.as_ref().filter(|_| storable(&texels)) {
         let mut payload = Vec::with_capacity(8 + 12 * texels.len());
         put(&mut payload, [width, height]);
         put(&mut payload, texels.iter().flatten().map(|v| v.to_bits()));
@@ -277,6 +282,13 @@ pub fn file_texels(
         cache::prune(path, FOLDER_BUDGET);
     }
     Ok((width, height, texels))
+}
+
+/// Whether decoded texels may be kept: all finite and within the documented bound. A file
+/// with others is refused or warned about on every load, so nothing is lost by decoding it
+/// again, and a cached entry with others can only be damaged.
+fn storable(texels: &[[f32; 3]]) -> bool {
+    texels.iter().flatten().all(|v| v.is_finite() && v.abs() <= MAX_TEXEL)
 }
 
 #[cfg(test)]
@@ -313,6 +325,17 @@ mod tests {
         let guide_at = 24 + 4 + 4 * 33;
         bad_guide[guide_at..guide_at + 4].copy_from_slice(&1000u32.to_le_bytes());
         assert!(decode_tables(&bad_guide, 64, 32).is_none());
+        // Values no map builds: NaN, a CDF that falls, a negative pdf.
+        let cdf_at = 24 + 4 + 4 * 5;
+        for value in [f32::NAN, -0.5, 2.0] {
+            let mut bad_cdf = bytes.clone();
+            bad_cdf[cdf_at..cdf_at + 4].copy_from_slice(&value.to_le_bytes());
+            assert!(decode_tables(&bad_cdf, 64, 32).is_none(), "cdf {value}");
+        }
+        let mut bad_pdf = bytes.clone();
+        let pdf_at = bytes.len() - 4;
+        bad_pdf[pdf_at..].copy_from_slice(&f32::NAN.to_le_bytes());
+        assert!(decode_tables(&bad_pdf, 64, 32).is_none());
         // A huge declared count is refused without allocating it.
         let mut huge = bytes;
         huge[24..28].copy_from_slice(&u32::MAX.to_le_bytes());

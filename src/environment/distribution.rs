@@ -66,8 +66,21 @@ pub fn bucket(u: f32, n: u32) -> u32 {
 
 impl Table {
     pub(crate) fn new(weights: &[f64]) -> Table {
-        let cdf = cdf(weights);
-        let n = weights.len() as u32;
+        Table::with_cdf(cdf(weights))
+    }
+
+    /// The table of a CDF: n + 1 entries, exactly 0 first and 1 last, never decreasing. None
+    /// for anything else (a damaged cache file's): a search in it could go anywhere.
+    pub(crate) fn from_cdf(cdf: Vec<f32>) -> Option<Table> {
+        let valid = cdf.len() >= 2
+            && cdf[0] == 0.0
+            && cdf[cdf.len() - 1] == 1.0
+            && cdf.windows(2).all(|pair| pair[0] <= pair[1]);
+        valid.then(|| Table::with_cdf(cdf))
+    }
+
+    fn with_cdf(cdf: Vec<f32>) -> Table {
+        let n = (cdf.len() - 1) as u32;
         let guide = (0..=n)
             .map(|k| {
                 let u = if k == n { 1.0 } else { smallest_in_bucket(k, n) };

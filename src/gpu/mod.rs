@@ -3,6 +3,7 @@
 //! timestamps.
 
 pub mod context;
+pub mod driver_cache;
 pub mod graphics;
 #[doc(hidden)]
 pub mod inject;
