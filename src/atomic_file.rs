@@ -82,6 +82,10 @@ pub fn write_unsynced(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 fn put(path: &Path, replace: bool, sync: bool, fill: impl FnOnce(&mut File) -> std::io::Result<()>) -> Result<()> {
+    // A folder (`.`, say) cannot be replaced by a file; the rename would say only "busy".
+    if path.is_dir() || path.file_name().is_none() {
+        return Err(Error::input_file(path, "is a folder: name a file to write"));
+    }
     remove_stale_temporaries(path);
     let temporary = temporary_path(path);
     let result = (|| {
@@ -110,6 +114,15 @@ fn put(path: &Path, replace: bool, sync: bool, fill: impl FnOnce(&mut File) -> s
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_folder_is_never_a_file_to_write() {
+        let dir = tempfile::tempdir().unwrap();
+        for path in [dir.path().to_path_buf(), dir.path().join("."), dir.path().join("..")] {
+            let message = write(&path, b"x").unwrap_err().to_string();
+            assert!(message.ends_with("is a folder: name a file to write"), "{message}");
+        }
+    }
 
     #[test]
     fn temporaries_of_dead_processes_are_removed_and_live_ones_kept() {

@@ -90,18 +90,24 @@ pub fn number_text<T: Into<f64> + Copy + fmt::Display + fmt::LowerExp>(x: T) -> 
 }
 
 /// `text` with every control character escaped (`\x1b`, `\0`, `\u{9b}`), so that names read
-/// from files can neither break a message's one line nor send escape sequences to a terminal.
+/// from files can neither break a message's one line nor send escape sequences to a terminal;
+/// and the bidirectional controls too (`\u{202e}`), which would show a name reversed.
 pub fn printable(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     for c in text.chars() {
         match c {
             '\0' => out.push_str("\\0"),
             c if c.is_control() && (c as u32) < 0x80 => out.push_str(&format!("\\x{:02x}", c as u32)),
-            c if c.is_control() => out.push_str(&format!("\\u{{{:x}}}", c as u32)),
+            c if c.is_control() || is_bidi_control(c) => out.push_str(&format!("\\u{{{:x}}}", c as u32)),
             c => out.push(c),
         }
     }
     out
+}
+
+/// The Unicode bidirectional formatting characters: marks, embeddings, overrides and isolates.
+fn is_bidi_control(c: char) -> bool {
+    matches!(c, '\u{061c}' | '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
 }
 
 impl std::error::Error for Error {}
@@ -129,5 +135,9 @@ mod tests {
     fn messages_are_one_line_with_control_characters_escaped() {
         let error = Error::input_file("look.toml", "no preset named '\u{1b}[31mred\0'\nsecond line\u{9b}");
         assert_eq!(error.to_string(), "look.toml: no preset named '\\x1b[31mred\\0' second line\\u{9b}");
+        // A right-to-left override would show what follows it reversed.
+        assert_eq!(printable("gold\u{202e}lmt.exe"), "gold\\u{202e}lmt.exe");
+        assert_eq!(printable("a\u{2066}b\u{200f}"), "a\\u{2066}b\\u{200f}");
+        assert_eq!(printable("Käse · 金"), "Käse · 金");
     }
 }

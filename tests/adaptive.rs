@@ -244,8 +244,11 @@ fn a_look_can_ask_for_adaptive_sampling() {
     assert!(pixels() != from_look);
 
     let lone = look("lone.toml", "min_spp = 8\n");
-    assert_bad_input(&render(&lone, &[]), &["lone.toml: [render] min_spp = 8", "only adaptive sampling"]);
+    assert_bad_input(
+        &render(&lone, &[]),
+        &["lone.toml:3: [render] min_spp = 8", "only adaptive sampling takes it", "[render] noise_threshold"],
+    );
     let over = look("over.toml", "noise_threshold = 0.1\nmin_spp = 128\n");
-    assert_bad_input(&render(&over, &[]), &["over.toml: [render] min_spp = 128", "above spp"]);
+    assert_bad_input(&render(&over, &[]), &["over.toml:4: [render] min_spp = 128", "above spp"]);
     assert_success(&render(&over, &["--min-spp", "16"]));
 }

@@ -592,6 +592,36 @@ fn the_mapping_holds_for_every_listed_extension_and_unsupported_ones_are_named()
     assert_eq!(std::fs::read_to_string(&look).unwrap(), look_text);
 }
 
+/// What import writes for people to read carries no float noise: glTF's IOR 1.5 is F0 0.04,
+/// exactly Disney's specular 0.5, and a factor of 0.3 stays 0.3.
+#[test]
+fn imported_presets_hold_the_values_without_float_noise() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut gltf = Gltf::new();
+    gltf.uses_extension("KHR_materials_ior");
+    let material = gltf.material(json!({
+        "name": "plastic",
+        "pbrMetallicRoughness": { "baseColorFactor": [0.3, 0.7, 0.1, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.3 },
+        "extensions": { "KHR_materials_ior": { "ior": 1.5 } }
+    }));
+    let mesh = gltf.mesh("ball", &[(&uv_sphere(1.0, 16, 8), Some(material))]);
+    gltf.node(json!({ "name": "ball", "mesh": mesh }));
+    let path = gltf.write_gltf(dir.path(), "plastic");
+    let (presets, look) = (dir.path().join("presets"), dir.path().join("plastic.toml"));
+    assert_success(&lookdev(&[
+        "import",
+        path.to_str().unwrap(),
+        "--presets",
+        presets.to_str().unwrap(),
+        "--look",
+        look.to_str().unwrap(),
+    ]));
+    let text = std::fs::read_to_string(presets.join("plastic.toml")).unwrap();
+    for line in ["specular = 0.5\n", "roughness = 0.3\n", "base_color = [0.3, 0.7, 0.1]\n"] {
+        assert!(text.contains(line), "no '{}' in:\n{text}", line.trim());
+    }
+}
+
 fn read_exr(path: &Path) -> Vec<[f32; 4]> {
     let image = exr::prelude::read_first_rgba_layer_from_file(
         path,

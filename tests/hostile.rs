@@ -381,6 +381,24 @@ fn messages_name_what_is_wrong_and_only_that() {
         &["the look's [render] aovs are not written into a PNG (x.png)"],
     );
 
+    // An environment the look names is reported at the look's line, with the path it resolved to.
+    std::fs::create_dir(d.join("shots")).unwrap();
+    write(d, "shots/env.toml", "[render]\nspp = 1\n[environment]\nfile = \"nope.exr\"\n");
+    refused(
+        d,
+        &["render", "--look", "shots/env.toml", "--out", "x.png"],
+        &["shots/env.toml:4: [environment] file: shots/nope.exr: file not found"],
+        200,
+    );
+    write(d, "shots/jpeg.toml", "[environment]\nfile = \"sky.jpg\"\n");
+    write(d, "shots/sky.jpg", "not an image");
+    refused(
+        d,
+        &["render", "--look", "shots/jpeg.toml", "--out", "x.png"],
+        &["shots/jpeg.toml:2: [environment] file: shots/sky.jpg"],
+        200,
+    );
+
     // A folder given as the environment is called a folder, as formats.md promises.
     std::fs::create_dir(d.join("envs")).unwrap();
     refused(d, &["render", "--env", "envs", "--out", "x.png"], &["envs", "not a regular file (a folder)"], 200);
@@ -422,5 +440,142 @@ fn size_flags_are_bounded_before_any_work() {
         &["--values: 65 values, more than the 64 a wedge shows"],
         200,
     );
+    for frames in ["0", "10801"] {
+        refused(
+            d,
+            &["turntable", "--frames", frames, "--out", "t%d.png"],
+            &[&format!("--frames {frames}: a turntable has 1 to 10800 frames")],
+            200,
+        );
+    }
     assert!(!d.join("s.png").exists() && !d.join("w.png").exists());
+}
+
+/// An output is never one of the command's own inputs, by any path: `--out g.exr` once replaced
+/// the g-buffer it rendered, and `import s.gltf --look s.gltf --force` the asset it read.
+#[test]
+fn outputs_never_replace_the_commands_own_inputs() {
+    use serde_json::json;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let ok = |args: &[&str]| {
+        let run = lookdev_measured(d, args, 120.0, None);
+        assert!(run.output.status.success(), "lookdev {}: {}", args.join(" "), stderr(&run.output));
+    };
+    ok(&["gbuffer", "--builtin", "shaderball", "--size", "16", "16", "--out", "g.exr"]);
+    let studio = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/environment/studio.exr");
+    std::fs::copy(&studio, d.join("e.exr")).unwrap();
+    std::fs::hard_link(d.join("e.exr"), d.join("link.exr")).unwrap();
+    write(d, "look.toml", "[render]\nspp = 1\n");
+    let before: Vec<Vec<u8>> =
+        ["g.exr", "e.exr", "look.toml"].iter().map(|f| std::fs::read(d.join(f)).unwrap()).collect();
+    let render =
+        ["render", "--gbuffer", "g.exr", "--env", "e.exr", "--env-clamp", "--look", "look.toml", "--spp", "1", "--out"];
+    for (out, what) in [
+        ("g.exr", "a g-buffer, g.exr"),
+        ("./e.exr", "an environment, e.exr"),
+        ("link.exr", "an environment, e.exr"),
+        ("look.toml.exr", ""),
+    ] {
+        if what.is_empty() {
+            ok(&[&render[..], &[out]].concat());
+            continue;
+        }
+        refused(d, &[&render[..], &[out]].concat(), &[out, &format!("the output would replace {what}")], 200);
+    }
+    // The same through the other writers: a turntable's frames, a g-buffer, an import's look.
+    std::fs::hard_link(d.join("e.exr"), d.join("e2.exr")).unwrap();
+    refused(
+        d,
+        &[
+            "turntable",
+            "--gbuffer",
+            "g.exr",
+            "--env",
+            "e.exr",
+            "--env-clamp",
+            "--spp",
+            "1",
+            "--frames",
+            "2",
+            "--out",
+            "e%d.exr",
+        ],
+        &["e2.exr", "the output would replace an environment"],
+        200,
+    );
+    assert!(!d.join("e1.exr").exists(), "refused before the first frame");
+    let after: Vec<Vec<u8>> =
+        ["g.exr", "e.exr", "look.toml"].iter().map(|f| std::fs::read(d.join(f)).unwrap()).collect();
+    assert!(before == after, "an input was changed");
+
+    let mut gltf = common::gltf::Gltf::new();
+    let material = gltf.material(json!({ "name": "painted", "pbrMetallicRoughness": { "roughnessFactor": 0.4 } }));
+    let mesh = gltf.mesh("ball", &[(&common::gltf::uv_sphere(1.0, 16, 8), Some(material))]);
+    gltf.node(json!({ "name": "ball", "mesh": mesh }));
+    let model = gltf.write_gltf(d, "s");
+    let model = model.file_name().unwrap().to_str().unwrap();
+    let asset = std::fs::read(d.join(model)).unwrap();
+    refused(
+        d,
+        &["import", model, "--presets", "pr", "--look", model, "--force"],
+        &[model, "the output would replace a glTF file"],
+        200,
+    );
+    std::fs::hard_link(d.join(model), d.join("linked.exr")).unwrap();
+    refused(
+        d,
+        &["bake", model, "--size", "8", "8", "--out", "linked.exr"],
+        &["linked.exr", "the output would replace a glTF file"],
+        200,
+    );
+    assert!(std::fs::read(d.join(model)).unwrap() == asset, "the asset was changed");
+    // The look may not take the place of a preset the import writes beside it.
+    std::fs::create_dir(d.join("pr")).unwrap();
+    refused(
+        d,
+        &["import", model, "--presets", "pr", "--look", "pr/painted.toml"],
+        &["pr/painted.toml", "the look would replace the preset 'painted' this import writes there"],
+        200,
+    );
+    assert!(!d.join("pr/painted.toml").exists(), "nothing is written when the import is refused");
+}
+
+/// Vertex attributes that are not finite are refused by the bake, naming the accessor; a vertex
+/// colour beyond [0, 1] is clamped with a warning. Both once baked silently into files that
+/// `render` then refused.
+#[test]
+fn bake_refuses_attributes_that_are_not_finite_and_clamps_colours() {
+    use serde_json::json;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let model = |name: &str, change: &dyn Fn(&mut common::gltf::Mesh)| {
+        let mut mesh = common::gltf::uv_sphere(1.0, 16, 8);
+        mesh.colors = Some(vec![[0.5, 0.5, 0.5, 1.0]; mesh.positions.len()]);
+        change(&mut mesh);
+        let mut gltf = common::gltf::Gltf::new();
+        let mesh = gltf.mesh("ball", &[(&mesh, None)]);
+        gltf.node(json!({ "name": "ball", "mesh": mesh }));
+        gltf.write_gltf(d, name).file_name().unwrap().to_string_lossy().into_owned()
+    };
+    let nan_uv = model("nan-uv", &|m| m.uvs[5][0] = f32::NAN);
+    let infinite_colour = model("inf-color", &|m| m.colors.as_mut().unwrap()[3][1] = f32::INFINITY);
+    let huge_colour = model("huge-color", &|m| m.colors.as_mut().unwrap()[3][0] = 3e38);
+    for (file, attribute) in [(&nan_uv, "TEXCOORD_0 (accessor 2)"), (&infinite_colour, "COLOR_0 (accessor 3)")] {
+        refused(
+            d,
+            &["bake", file, "--size", "16", "16", "--out", "g.exr"],
+            &[file, "mesh 0 'ball' primitive 0", &format!("{attribute} has values that are not finite")],
+            200,
+        );
+        assert!(!d.join("g.exr").exists());
+    }
+    succeeds_warning(
+        d,
+        &["bake", &huge_colour, "--size", "16", "16", "--visibility", "off", "--quiet", "--out", "g.exr"],
+        &["COLOR_0 (accessor 3) holds values from 0.5 to 3e38, outside [0, 1]; clamped"],
+    );
+    let run =
+        lookdev_measured(d, &["render", "--gbuffer", "g.exr", "--spp", "1", "--quiet", "--out", "x.exr"], 60.0, None);
+    assert!(run.output.status.success(), "the bake's own file renders: {}", stderr(&run.output));
 }

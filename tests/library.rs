@@ -139,6 +139,15 @@ fn save_round_trips_and_never_clobbers() {
     let leftovers: Vec<_> = std::fs::read_dir(s.library()).unwrap().map(|e| e.unwrap().file_name()).collect();
     assert_eq!(leftovers.len(), 1, "no temporary files left: {leftovers:?}");
 
+    // A built-in's name would shadow the built-in in every look: refused unless --force.
+    let refused = s.run(&["presets", "save", "gold", "--set", "roughness=0.9"]);
+    assert_eq!(refused.status.code(), Some(2), "{}", stderr(&refused));
+    assert!(stderr(&refused).contains("'gold' would shadow the built-in preset 'gold'"), "{}", stderr(&refused));
+    assert!(!s.library().join("gold.toml").exists());
+    ok(s.run(&["presets", "save", "gold", "--set", "roughness=0.9", "--force"]));
+    assert!(s.library().join("gold.toml").exists());
+    std::fs::remove_file(s.library().join("gold.toml")).unwrap();
+
     for bad in [
         vec!["presets", "save", "Bad Name", "--set", "roughness=0.5"],
         vec!["presets", "save", "nothing"],
@@ -184,8 +193,10 @@ fn contact_sheet_matches_its_golden_image() {
         s.write(&format!("library/{name}.toml"), &preset(roughness, "\"sheet-test\""));
     }
     let out = s.arg("sheet.png");
-    ok(s.run(&["presets", "sheet", "--tag", "sheet-test", "--size", "96", "--spp", "64", "--quiet", "--out", &out]));
+    let run = ok(s.run(&["presets", "sheet", "--tag", "sheet-test", "--size", "96", "--spp", "64", "--out", &out]));
     let image = image::open(&out).unwrap().to_rgba8();
+    let said = format!("lookdev: wrote {out} (4 presets in 2 columns, {}x{})", image.width(), image.height());
+    assert!(stderr(&run).contains(&said), "{}", stderr(&run));
     golden("sheet.png", image.width(), image.height(), image.as_raw());
 }
 
@@ -193,7 +204,7 @@ fn contact_sheet_matches_its_golden_image() {
 fn wedge_matches_its_golden_image() {
     let s = Setup::new();
     let out = s.arg("wedge.png");
-    ok(s.run(&[
+    let run = ok(s.run(&[
         "wedge",
         "--param",
         "roughness",
@@ -203,14 +214,32 @@ fn wedge_matches_its_golden_image() {
         "96",
         "--spp",
         "64",
-        "--quiet",
         "--out",
         &out,
     ]));
     let image = image::open(&out).unwrap().to_rgba8();
+    let said = format!("lookdev: wrote {out} (1 × 3 renders, {}x{})", image.width(), image.height());
+    assert!(stderr(&run).contains(&said), "{}", stderr(&run));
     golden("wedge_roughness.png", image.width(), image.height(), image.as_raw());
     let bad = s.run(&["wedge", "--param", "shininess", "--out", &out]);
     assert_eq!(bad.status.code(), Some(2));
+    let bad = s.run(&["wedge", "--param", "roughnes", "--out", &out]);
+    assert!(stderr(&bad).contains("--param roughnes: unknown parameter 'roughnes'"), "{}", stderr(&bad));
+    assert!(stderr(&bad).contains("did you mean 'roughness'?"), "{}", stderr(&bad));
+    let bad = s.run(&["presets", "list", "--tag", "metl"]);
+    assert!(stderr(&bad).contains("--tag metl: no preset has this tag"), "{}", stderr(&bad));
+    assert!(stderr(&bad).contains("did you mean 'metal'?"), "{}", stderr(&bad));
+    // A PNG-only image with another extension is refused before any render.
+    for command in [&["wedge", "--param", "roughness"][..], &["presets", "sheet"][..]] {
+        let exr = s.arg("sheet.exr");
+        let bad = s.run(&[command, &["--spp", "4096", "--out", &exr][..]].concat());
+        assert_eq!(bad.status.code(), Some(2), "{}", stderr(&bad));
+        assert!(
+            stderr(&bad).contains("this image is written only as PNG: name the output FILE.png"),
+            "{}",
+            stderr(&bad)
+        );
+    }
     let bad = s.run(&["wedge", "--param", "metallic", "--values", "0,2", "--out", &out]);
     assert_eq!(bad.status.code(), Some(2));
 }

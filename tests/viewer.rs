@@ -275,7 +275,8 @@ fn a_click_inspects_the_pixel_and_selects_its_object() {
     let layers = &look.stack_for(1).unwrap().layers;
     let expected = layers[0].params.metallic * (1.0 - m) + layers[1].params.metallic * m;
     let metallic: f32 = line.split(" metallic=").nth(1).and_then(|v| v.split(' ').next()).unwrap().parse().unwrap();
-    assert!((metallic - expected).abs() < 1e-6, "the blended material: {line}");
+    // Printed to four decimals, for people.
+    assert!((metallic - expected).abs() <= 5e-5, "the blended material: {line}");
     assert_radiance_is_rendered(&case, line, ball);
 
     // Each click selected the object under it: the ball's top layer got the roughness, and the

@@ -185,7 +185,37 @@ fn read_primitive(asset: &Asset, mesh: &gltf::Mesh, primitive: &gltf::Primitive)
     let tangents: Option<Vec<[f32; 4]>> = reader.read_tangents().map(Iterator::collect);
     let uv0: Option<Vec<[f32; 2]>> = reader.read_tex_coords(0).map(|t| t.into_f32().collect());
     let uv1: Option<Vec<[f32; 2]>> = reader.read_tex_coords(1).map(|t| t.into_f32().collect());
-    let colors: Option<Vec<[f32; 4]>> = reader.read_colors(0).map(|c| c.into_rgba_f32().collect());
+    let mut colors: Option<Vec<[f32; 4]>> = reader.read_colors(0).map(|c| c.into_rgba_f32().collect());
+    let accessor = |semantic: gltf::Semantic| {
+        let name = semantic.to_string();
+        primitive.get(&semantic).map_or(name.clone(), |a| format!("{name} (accessor {})", a.index()))
+    };
+    use gltf::Semantic;
+    let finite = |values: Option<&[f32]>, semantic: Semantic| match values {
+        Some(values) if !values.iter().all(|v| v.is_finite()) => {
+            Err(error(format!("{} has values that are not finite (NaN or infinite)", accessor(semantic))))
+        }
+        _ => Ok(()),
+    };
+    finite(normals.as_deref().map(|v| v.as_flattened()), Semantic::Normals)?;
+    finite(tangents.as_deref().map(|v| v.as_flattened()), Semantic::Tangents)?;
+    finite(uv0.as_deref().map(|v| v.as_flattened()), Semantic::TexCoords(0))?;
+    finite(uv1.as_deref().map(|v| v.as_flattened()), Semantic::TexCoords(1))?;
+    finite(colors.as_deref().map(|v| v.as_flattened()), Semantic::Colors(0))?;
+    // A vertex colour is a multiplier in [0, 1] (glTF 2.0, 3.7.2.1), and lookdev bakes it into
+    // masks, which hold [0, 1]: more is clamped, and said.
+    if let Some(colors) = colors.as_mut().filter(|c| c.iter().flatten().any(|v| !(0.0..=1.0).contains(v))) {
+        let (low, high) = colors.iter().flatten().fold((f32::MAX, f32::MIN), |(l, h), &v| (l.min(v), h.max(v)));
+        crate::warn(format!(
+            "{}: {}: {} holds values from {} to {}, outside [0, 1]; clamped",
+            asset.path.display(),
+            label(),
+            accessor(Semantic::Colors(0)),
+            crate::error::number_text(low),
+            crate::error::number_text(high)
+        ));
+        colors.iter_mut().flatten().for_each(|v| *v = v.clamp(0.0, 1.0));
+    }
     for (len, what) in [
         (normals.as_ref().map(Vec::len), "NORMAL"),
         (tangents.as_ref().map(Vec::len), "TANGENT"),

@@ -54,7 +54,8 @@ impl Import {
             .into_iter()
             .map(|used| {
                 let material = materials::material_of(asset, used.index);
-                let mapped = materials::map(&material, colored.contains(&used.index));
+                let mut mapped = materials::map(&material, colored.contains(&used.index));
+                mapped.params = significant(mapped.params);
                 let mut description = format!("'{}' from {source}.", used.label);
                 for note in &mapped.notes {
                     let mut letters = note.chars();
@@ -96,6 +97,7 @@ impl Import {
             model: None,
             gbuffer: Default::default(),
             objects: vec![ObjectStack::new(None, layers)],
+            lines: Default::default(),
         }
     }
 
@@ -111,9 +113,32 @@ impl Import {
         }
         let preset_paths: Vec<PathBuf> =
             self.materials.iter().map(|m| presets_dir.join(format!("{}.toml", m.preset.name))).collect();
+        // The look must not take the place of a preset written beside it, nor any output that of
+        // the asset it comes from.
+        let look_place = in_folder(&look_folder, look_file);
+        if let Some(imported) = self.materials.iter().find(|m| {
+            look_place.is_some()
+                && in_folder(presets_dir, &presets_dir.join(format!("{}.toml", m.preset.name))) == look_place
+        }) {
+            return Err(Error::input_file(
+                look_file,
+                format!(
+                    "the look would replace the preset '{}' this import writes there; give the look another name or folder",
+                    imported.preset.name
+                ),
+            ));
+        }
+        for path in preset_paths.iter().chain([&look_file.to_path_buf()]) {
+            crate::input::refuse_replacing_input(path)?;
+        }
         if !force {
             if let Some(existing) = preset_paths.iter().chain([&look_file.to_path_buf()]).find(|p| p.exists()) {
                 return Err(Error::input_file(existing, "already exists (use --force to replace it)"));
+            }
+            if let Some(imported) =
+                self.materials.iter().find(|m| crate::material::library::shadows_builtin(presets_dir, &m.preset.name))
+            {
+                return Err(crate::material::library::shadowing_error(&imported.preset.name));
             }
         }
         let mut written = Vec::new();
@@ -138,6 +163,28 @@ impl Import {
         written.push(look_file.to_path_buf());
         Ok(written)
     }
+}
+
+/// The parameters to six significant digits, as precise as glTF's factors are written, without
+/// the float noise of the conversions: IOR 1.5 gives specular 0.5, not 0.50000006.
+fn significant(mut params: crate::material::Params) -> crate::material::Params {
+    use crate::material::params::Value;
+    let round = |x: f32| format!("{x:.5e}").parse::<f32>().unwrap_or(x);
+    for param in Param::ALL {
+        let value = match params.get(param) {
+            Value::Scalar(x) => Value::Scalar(round(x)),
+            Value::Color(rgb) => Value::Color(rgb.map(round)),
+        };
+        // Rounding to six digits keeps a value inside the range it was in.
+        let _ = params.set(param, value);
+    }
+    params
+}
+
+/// Where `file` in `folder` lives, by the folder's real path: two names of one place compare
+/// equal. None when the folder does not exist (yet), and so holds nothing.
+fn in_folder(folder: &Path, file: &Path) -> Option<PathBuf> {
+    Some(folder.canonicalize().ok()?.join(file.file_name()?))
 }
 
 /// `to` as seen from the folder `from`: relative when both resolve on disk, else absolute.
@@ -192,6 +239,13 @@ mod tests {
         g.masks = masks.iter().map(|&(n, v)| (n.to_string(), vec![v])).collect();
         g.maps = maps.iter().map(|&(n, v)| (n.to_string(), vec![v])).collect();
         g
+    }
+
+    #[test]
+    fn imported_values_carry_no_float_noise() {
+        let noisy = Params { specular: 0.50000006, metallic: 0.9999996, roughness: 0.123_456_7, ..Params::default() };
+        let tidy = significant(noisy);
+        assert_eq!((tidy.specular, tidy.metallic, tidy.roughness), (0.5, 1.0, 0.123457));
     }
 
     #[test]

@@ -190,10 +190,7 @@ pub fn parse_set(text: &str) -> Result<(Param, Value)> {
     let (name, value) = text
         .split_once('=')
         .ok_or_else(|| Error::input(format!("--set {text}: expected NAME=VALUE, e.g. roughness=0.3")))?;
-    let param = Param::from_name(name.trim()).ok_or_else(|| {
-        let names = Param::ALL.map(Param::name);
-        Error::input(format!("--set {text}: {}", crate::suggest::unknown("parameter", name.trim(), "", &names)))
-    })?;
+    let param = Param::parse(name.trim()).map_err(|e| Error::input(format!("--set {text}: {e}")))?;
     let value = parse_value(param, value).map_err(|e| Error::input(format!("--set {text}: {e}")))?;
     Ok((param, value))
 }

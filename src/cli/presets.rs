@@ -107,6 +107,7 @@ pub fn run(args: PresetsArgs) -> Result<()> {
 /// rest of the library.
 fn presets_with_tag(tag: Option<&str>) -> Result<Vec<(Preset, Origin)>> {
     let mut out = Vec::new();
+    let mut all_tags = std::collections::BTreeSet::new();
     for (_, origin, preset) in Library::standard().entries() {
         let preset = match preset {
             Ok(preset) => preset,
@@ -115,12 +116,15 @@ fn presets_with_tag(tag: Option<&str>) -> Result<Vec<(Preset, Origin)>> {
                 continue;
             }
         };
+        all_tags.extend(preset.tags.clone());
         if tag.is_none_or(|t| preset.tags.iter().any(|p| p == t)) {
             out.push((preset, origin));
         }
     }
     if let (Some(tag), true) = (tag, out.is_empty()) {
-        return Err(Error::input(format!("--tag {tag}: no preset has this tag")));
+        let tags: Vec<&str> = all_tags.iter().map(String::as_str).collect();
+        let hint = crate::suggest::near_miss(tag, &tags).map(|t| format!("; did you mean '{t}'?")).unwrap_or_default();
+        return Err(Error::input(format!("--tag {tag}: no preset has this tag (the tags: {}){hint}", tags.join(", "))));
     }
     Ok(out)
 }
@@ -254,6 +258,7 @@ fn layer_params(look_path: &Path, object: &str, layer: usize) -> Result<(Params,
 }
 
 fn sheet(args: SheetArgs) -> Result<()> {
+    crate::render::output::require_png(&args.out)?;
     if args.spp == 0 {
         return Err(Error::input("--spp 0: the sample count must be at least 1"));
     }
@@ -295,5 +300,15 @@ fn sheet(args: SheetArgs) -> Result<()> {
     super::check_validation(&counter)?;
     let columns = args.columns.unwrap_or_else(|| (cells.len() as f64).sqrt().ceil() as usize).clamp(1, MAX_COLUMNS);
     let image = sheet::grid(&cells, columns);
-    crate::render::output::write_png_image(&args.out, &image)
+    crate::render::output::write_png_image(&args.out, &image)?;
+    if !args.quiet {
+        eprintln!(
+            "lookdev: wrote {} ({} presets in {columns} columns, {}x{})",
+            args.out.display(),
+            cells.len(),
+            image.width(),
+            image.height()
+        );
+    }
+    Ok(())
 }

@@ -176,6 +176,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let (scene, rendered, device_name) = std::thread::scope(|threads| -> Result<_> {
         let specialize = |scene: &Scene| kernels_for(scene, &output_aovs(format, display, &scene.settings));
         let Started { scene, ctx, kernels } = startup::start(threads, &spec, options, specialize)?;
+        // Every input is read by now: refuse before the work, not after it.
+        crate::input::refuse_replacing_input(&args.out)?;
         let counter = ctx.validation_counter();
         let device_name = ctx.info().name.clone();
         let aovs = output_aovs(format, display, &scene.settings);

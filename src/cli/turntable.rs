@@ -24,14 +24,14 @@ pub struct TurntableArgs {
     pub look: Option<PathBuf>,
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// Frames in the full turn.
+    /// Frames in the full turn, 1 to 10800.
     #[arg(long)]
     pub frames: u32,
     /// Write an AOV beside the beauty in EXR frames (repeatable), as `render --aov` does.
     #[arg(long = "aov", value_name = "NAME")]
     pub aovs: Vec<String>,
-    /// The frames to render, A-B inclusive, numbered from 1 (default: all).
-    #[arg(long, value_name = "A-B")]
+    /// The frames to render, A-B inclusive or one frame A, numbered from 1 (default: all).
+    #[arg(long, value_name = "A-B|A")]
     pub range: Option<String>,
     #[arg(long, value_name = "NAME")]
     pub device: Option<String>,
@@ -43,6 +43,10 @@ pub struct TurntableArgs {
     #[command(flatten)]
     pub adaptive: super::render::AdaptiveArgs,
 }
+
+/// The most frames a turntable has: a frame a degree at 1/30 of a degree, far beyond any real
+/// turn, and a bound on the loop over them.
+pub const MAX_FRAMES: u32 = 10_800;
 
 /// A printf-style frame pattern: the text around one `%d` or `%0Nd`.
 #[derive(Debug, PartialEq)]
@@ -72,10 +76,10 @@ impl FramePattern {
     }
 }
 
-/// Parses `A-B` (inclusive, 1-based) against `frames`.
+/// Parses `A-B` (inclusive, 1-based), or a single frame `A`, against `frames`.
 pub fn parse_range(text: &str, frames: u32) -> Result<(u32, u32)> {
-    let bad = || Error::input(format!("--range {text}: expected A-B with 1 <= A <= B <= {frames}"));
-    let (a, b) = text.split_once('-').ok_or_else(bad)?;
+    let bad = || Error::input(format!("--range {text}: expected A-B with 1 <= A <= B <= {frames}, or one frame A"));
+    let (a, b) = text.split_once('-').unwrap_or((text, text));
     let (a, b): (u32, u32) = (a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?);
     if a < 1 || a > b || b > frames {
         return Err(bad());
@@ -84,8 +88,8 @@ pub fn parse_range(text: &str, frames: u32) -> Result<(u32, u32)> {
 }
 
 pub fn run(args: TurntableArgs) -> Result<()> {
-    if args.frames == 0 {
-        return Err(Error::input("--frames 0: a turntable needs at least one frame"));
+    if args.frames == 0 || args.frames > MAX_FRAMES {
+        return Err(Error::input(format!("--frames {}: a turntable has 1 to {MAX_FRAMES} frames", args.frames)));
     }
     let pattern = FramePattern::parse(&args.out)?;
     let format = OutputFormat::from_path(&pattern.path(1))?;
@@ -104,6 +108,10 @@ pub fn run(args: TurntableArgs) -> Result<()> {
     std::thread::scope(|threads| {
         let specialize = |scene: &Scene| Specialization::of_render(scene, aov::accumulate(&scene.settings.aovs));
         let Started { scene, ctx, kernels } = startup::start(threads, &spec, options, specialize)?;
+        // Every input is read by now: refuse before the first frame, not at one.
+        for frame in first..=last {
+            crate::input::refuse_replacing_input(&pattern.path(frame))?;
+        }
         let counter = ctx.validation_counter();
         scene.check_device(ctx.info())?;
         render_frames(&args, &scene, &ctx, KernelSource::Pending(kernels), &pattern, format, (first, last))?;
@@ -167,6 +175,8 @@ mod tests {
         assert!(FramePattern::parse("no_pattern.png").is_err());
         assert!(FramePattern::parse("a%04d_%04d.png").is_err());
         assert_eq!(parse_range("3-5", 10).unwrap(), (3, 5));
+        assert_eq!(parse_range("3", 10).unwrap(), (3, 3));
+        assert!(parse_range("11", 10).is_err());
         assert!(parse_range("0-5", 10).is_err());
         assert!(parse_range("5-3", 10).is_err());
         assert!(parse_range("5-11", 10).is_err());

@@ -76,10 +76,12 @@ fn value_label(v: f32) -> String {
 }
 
 pub fn run(args: WedgeArgs) -> Result<()> {
+    crate::render::output::require_png(&args.out)?;
     let params: Vec<Param> = match args.param.as_str() {
         "all" => Param::ALL.to_vec(),
         name => vec![Param::from_name(name).ok_or_else(|| {
-            Error::input(format!("--param {name}: unknown parameter (expected all, {})", Param::all_names()))
+            let names: Vec<&str> = std::iter::once("all").chain(Param::ALL.map(Param::name)).collect();
+            Error::input(format!("--param {name}: {}", crate::suggest::unknown("parameter", name, "", &names)))
         })?],
     };
     let values = if args.values.is_empty() { (0..=10).map(|i| i as f32 / 10.0).collect() } else { args.values.clone() };
@@ -147,5 +149,17 @@ pub fn run(args: WedgeArgs) -> Result<()> {
     };
     drop(ctx);
     super::check_validation(&counter)?;
-    crate::render::output::write_png_image(&args.out, &sheet::rows(&rows))
+    let image = sheet::rows(&rows);
+    crate::render::output::write_png_image(&args.out, &image)?;
+    if !args.quiet {
+        eprintln!(
+            "lookdev: wrote {} ({} × {} renders, {}x{})",
+            args.out.display(),
+            rows.len(),
+            values.len(),
+            image.width(),
+            image.height()
+        );
+    }
+    Ok(())
 }

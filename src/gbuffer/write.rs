@@ -22,6 +22,7 @@ impl GBuffer {
     /// The file appears atomically: it is written to a temporary file in the same folder, then
     /// renamed over `path`, so a reader never sees half a file.
     pub fn write(&self, path: &Path) -> Result<()> {
+        crate::input::refuse_replacing_input(path)?;
         self.check_lengths(path)?;
         let image = Image::from_layer(self.to_layer());
         crate::atomic_file::write_with(path, true, |file| {

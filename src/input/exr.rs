@@ -45,6 +45,13 @@ pub struct Declared {
 /// Checks the header of the OpenEXR file `bytes` against `budget` and against the file's own
 /// size. Returns the problem, for the caller to prefix with the file's name.
 pub fn check(bytes: &[u8], budget: &Budget) -> Result<Declared, String> {
+    if let Some(code) = declared_compressions(bytes).into_iter().find(|&code| code > LAST_DECODED_COMPRESSION) {
+        return Err(format!(
+            "unsupported compression ({}): lookdev reads uncompressed, RLE, ZIPS, ZIP, PIZ, PXR24, B44, B44A, DWAA \
+             and DWAB files; save it again with ZIP or PIZ",
+            compression_name(code)
+        ));
+    }
     let meta = MetaData::read_from_buffered(bytes, false).map_err(|e| unreadable(&e))?;
     MetaData::validate(&meta.headers, false).map_err(|e| unreadable(&e))?;
     let file_bytes = bytes.len() as u64;
@@ -180,6 +187,57 @@ fn sample_bytes(sample: SampleType) -> u64 {
     sample.bytes_per_sample() as u64
 }
 
+/// The highest OpenEXR compression code the reader decodes (DWAB).
+const LAST_DECODED_COMPRESSION: u8 = 9;
+
+/// The names OpenEXR gives the compression codes after the ones lookdev decodes.
+fn compression_name(code: u8) -> String {
+    match code {
+        10 => "HTJ2K256".into(),
+        11 => "HTJ2K32".into(),
+        _ => format!("code {code}, newer than lookdev's reader knows, such as ZSTD"),
+    }
+}
+
+/// The `compression` attribute of every header of the file, read straight from the bytes: the
+/// decoder refuses a code it does not know with a message about a damaged attribute, when the
+/// file is valid and only newer than the reader. Stops quietly at anything malformed, which the
+/// decoder then reports.
+fn declared_compressions(bytes: &[u8]) -> Vec<u8> {
+    const MULTIPART: u8 = 0x10;
+    let mut codes = Vec::new();
+    let Some(version) = bytes.get(4..8) else { return codes };
+    let multipart = version[1] & MULTIPART != 0;
+    let mut at = 8;
+    let text = |at: &mut usize| -> Option<&[u8]> {
+        let rest = bytes.get(*at..)?;
+        let end = rest.iter().take(256).position(|&b| b == 0)?;
+        *at += end + 1;
+        Some(&rest[..end])
+    };
+    loop {
+        let Some(name) = text(&mut at) else { return codes };
+        if name.is_empty() {
+            // A header ends with an empty name; a multi-part file's header list with an empty header.
+            if !multipart || bytes.get(at) == Some(&0) {
+                return codes;
+            }
+            continue;
+        }
+        let Some(kind) = text(&mut at) else { return codes };
+        let Some(size) = bytes.get(at..at + 4).map(|b| i32::from_le_bytes(b.try_into().expect("4 bytes"))) else {
+            return codes;
+        };
+        let Ok(size) = usize::try_from(size) else { return codes };
+        at += 4;
+        if name == b"compression" && kind == b"compression" && size == 1 {
+            let Some(&code) = bytes.get(at) else { return codes };
+            codes.push(code);
+        }
+        at = at.saturating_add(size);
+    }
+}
+
 fn unreadable(e: &exr::error::Error) -> String {
     format!("not a readable OpenEXR file ({e})")
 }
@@ -219,6 +277,21 @@ mod tests {
     }
 
     const BUDGET: Budget = Budget { max_side: MAX_SIDE, max_decoded_bytes: 1 << 30 };
+
+    #[test]
+    fn a_compression_newer_than_the_reader_is_named_as_unsupported() {
+        let mut bytes = file(4, 4, 4 * 4 * 6 + 4 * 16);
+        let at = bytes.windows(12).position(|w| w == b"compression\0").unwrap() + 12 + 12 + 4;
+        for (code, name) in [(10, "HTJ2K256"), (12, "code 12, newer")] {
+            bytes[at] = code;
+            let message = check(&bytes, &BUDGET).unwrap_err();
+            assert!(message.starts_with(&format!("unsupported compression ({name}")), "{message}");
+        }
+        bytes[at] = 3;
+        if let Err(message) = check(&bytes, &BUDGET) {
+            assert!(!message.contains("unsupported"), "{message}");
+        }
+    }
 
     #[test]
     fn a_header_that_fits_its_file_is_accepted() {

@@ -13,7 +13,10 @@
 
 pub mod exr;
 pub mod image;
+mod inputs;
 pub mod readers;
+
+pub use inputs::refuse_replacing_input;
 
 use crate::{Error, Result};
 use std::fs::File;
@@ -117,6 +120,9 @@ pub fn read_bytes_at_most(path: &Path, kind: Kind, cap: u64) -> std::result::Res
     }
     if meta.len() > cap {
         return Err(too_large(meta.len(), cap, kind));
+    }
+    if kind != Kind::Cache {
+        inputs::record(path, &meta, kind);
     }
     let mut bytes = Vec::with_capacity(meta.len() as usize);
     // One byte more than the cap tells a file that grew past it from one that fills it.

@@ -20,6 +20,7 @@ pub fn csv_path(plot: &Path) -> PathBuf {
 }
 
 fn write_text(path: &Path, text: &str) -> Result<()> {
+    crate::input::refuse_replacing_input(path)?;
     crate::atomic_file::write(path, text.as_bytes())
 }
 

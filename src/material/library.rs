@@ -66,12 +66,32 @@ pub fn save_preset(dir: &Path, preset: &Preset, force: bool) -> crate::Result<Pa
     let text = preset.to_toml();
     // What is saved must load: a file the library cannot read back would break every listing.
     Preset::parse(&text, &path).map_err(|e| crate::Error::input(format!("not saved: {e}")))?;
+    if !force && shadows_builtin(dir, &preset.name) {
+        return Err(shadowing_error(&preset.name));
+    }
     if force {
         crate::atomic_file::write(&path, text.as_bytes())?;
     } else {
         crate::atomic_file::write_new(&path, text.as_bytes())?;
     }
     Ok(path)
+}
+
+/// Whether a preset `name` saved in `dir` would shadow a built-in preset: `dir` is the user
+/// library, where every look finds it before the built-in one.
+pub fn shadows_builtin(dir: &Path, name: &str) -> bool {
+    let same_folder = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => a == b,
+    };
+    builtin(name).is_some() && user_library_dir().is_some_and(|library| same_folder(dir, &library))
+}
+
+/// The refusal to shadow the built-in preset `name` without being told to.
+pub fn shadowing_error(name: &str) -> crate::Error {
+    crate::Error::input(format!(
+        "'{name}' would shadow the built-in preset '{name}' in every look that names it; choose another name, or --force to save it anyway"
+    ))
 }
 
 /// Names already reported as shadowing a built-in preset, so each is reported once.

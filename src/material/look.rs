@@ -31,6 +31,20 @@ pub struct Look {
     pub gbuffer: GBufferSettings,
     /// From `[[object]]`, in file order.
     pub objects: Vec<ObjectStack>,
+    /// Where some keys were written, for the errors found only once the look is used.
+    pub lines: KeyLines,
+}
+
+/// The lines on which a look wrote the keys whose problems show only once it is used
+/// (`"render.min_spp"`, `"environment.file"`). Not part of what the look means: any two compare
+/// equal, as a layer's `line` does not count in its equality.
+#[derive(Clone, Debug, Default)]
+pub struct KeyLines(BTreeMap<&'static str, usize>);
+
+impl PartialEq for KeyLines {
+    fn eq(&self, _: &KeyLines) -> bool {
+        true
+    }
 }
 
 /// `[gbuffer]`: the g-buffer file (resolved against the look file's folder) and how to read
@@ -213,6 +227,16 @@ impl Look {
         parse_with(src, &Library::builtin_only()).expect("the built-in default look parses (tested)")
     }
 
+    /// Where `key` (`"render.min_spp"`) is written, for a message: `FILE:LINE`, or the file, or
+    /// "the look" for a look that has no file.
+    pub fn place(&self, key: &str) -> String {
+        match (&self.file, self.lines.0.get(key)) {
+            (Some(file), Some(line)) => format!("{}:{line}", file.display()),
+            (Some(file), None) => file.display().to_string(),
+            (None, _) => "the look".to_string(),
+        }
+    }
+
     /// The look used for a user g-buffer rendered without a look: every object in the default
     /// material (docs/formats.md#presets; defaults: grey 0.8 dielectric, roughness 0.5), default settings.
     pub fn default_material() -> Look {
@@ -223,6 +247,7 @@ impl Look {
             model: None,
             gbuffer: GBufferSettings::default(),
             objects: Vec::new(),
+            lines: KeyLines::default(),
         };
         look.ensure_default_stack();
         look
@@ -559,6 +584,15 @@ struct LayerFile {
 fn parse_with(src: Source, library: &Library) -> crate::Result<Look> {
     let raw: LookFile = src.decode()?;
     let folder = src.file.parent().unwrap_or(Path::new(""));
+    let mut lines = KeyLines::default();
+    let mut note = |key: &'static str, field: Option<&Field>| {
+        if let Some(field) = field {
+            lines.0.insert(key, src.line(field.span().start));
+        }
+    };
+    note("render.min_spp", raw.render.as_ref().and_then(|r| r.min_spp.as_ref()));
+    note("render.noise_threshold", raw.render.as_ref().and_then(|r| r.noise_threshold.as_ref()));
+    note("environment.file", raw.environment.as_ref().and_then(|e| e.file.as_ref()));
     let look = Look {
         file: None,
         environment: environment(&src, raw.environment, folder)?,
@@ -566,6 +600,7 @@ fn parse_with(src: Source, library: &Library) -> crate::Result<Look> {
         model: model(&src, raw.model.as_ref())?,
         gbuffer: gbuffer(&src, raw.gbuffer, folder)?,
         objects: objects(&src, &raw.object, library)?,
+        lines,
     };
     warn_about_bottom_layers(&src, &look);
     Ok(look)

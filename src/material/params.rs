@@ -72,6 +72,12 @@ impl Param {
         Param::ALL.into_iter().find(|p| p.name() == name)
     }
 
+    /// The parameter named `name`, or the message that lists the names and suggests the closest.
+    pub fn parse(name: &str) -> Result<Param, String> {
+        Param::from_name(name)
+            .ok_or_else(|| crate::suggest::unknown("parameter", name, "", &Param::ALL.map(Param::name)))
+    }
+
     /// Whether the value is a linear RGB colour (`base_color`, `emission`) rather than a number.
     pub fn is_color(self) -> bool {
         matches!(self, Param::BaseColor | Param::Emission)
@@ -106,11 +112,6 @@ impl Param {
             Param::Emission => offset_of!(GpuParams, emission),
         };
         offset / 4
-    }
-
-    /// The names of all parameters, for error messages.
-    pub fn all_names() -> String {
-        Param::ALL.map(Param::name).join(", ")
     }
 }
 
@@ -169,6 +170,26 @@ impl fmt::Display for Param {
 pub enum Value {
     Scalar(f32),
     Color([f32; 3]),
+}
+
+impl Value {
+    /// The value for people to read: four decimals, trailing zeros dropped, so that a blend's
+    /// float noise (0.9999996, 2.5e-7) reads as what it means (1, 0).
+    pub fn short_text(self) -> String {
+        let short = |x: f32| {
+            let text = format!("{x:.4}");
+            let text = text.trim_end_matches('0').trim_end_matches('.');
+            if text == "-0" {
+                "0".to_string()
+            } else {
+                text.to_string()
+            }
+        };
+        match self {
+            Value::Scalar(v) => short(v),
+            Value::Color([r, g, b]) => format!("[{}, {}, {}]", short(r), short(g), short(b)),
+        }
+    }
 }
 
 impl fmt::Display for Value {
@@ -417,6 +438,16 @@ mod tests {
         }
         let listed: usize = GROUPS.iter().map(|(_, params)| params.len()).sum();
         assert_eq!(listed, Param::ALL.len(), "a group lists a parameter twice");
+    }
+
+    #[test]
+    fn values_for_people_drop_float_noise() {
+        assert_eq!(Value::Scalar(0.9999996).short_text(), "1");
+        assert_eq!(Value::Scalar(2.5e-7).short_text(), "0");
+        assert_eq!(Value::Scalar(-1e-9).short_text(), "0");
+        assert_eq!(Value::Scalar(0.05).short_text(), "0.05");
+        assert_eq!(Value::Scalar(12.5).short_text(), "12.5");
+        assert_eq!(Value::Color([0.8, 0.3 + 1e-7, 0.0]).short_text(), "[0.8, 0.3, 0]");
     }
 
     #[test]

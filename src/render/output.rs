@@ -55,6 +55,7 @@ pub fn write_exr_with(
         AnyChannel, AnyChannels, AttributeValue, Encoding, FlatSamples, Image, Layer, LayerAttributes, Text,
         WritableImage,
     };
+    crate::input::refuse_replacing_input(path)?;
     check_finite(path, radiance)?;
     for layer in layers {
         for (channel, values) in &layer.channels {
@@ -167,6 +168,7 @@ impl Metadata {
 
 /// Writes display pixels (RGBA8, sRGB-encoded) as a PNG: RGB when opaque, RGBA otherwise.
 pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[u8], with_alpha: bool) -> Result<()> {
+    crate::input::refuse_replacing_input(path)?;
     let mut bytes = std::io::Cursor::new(Vec::new());
     let encoded = if with_alpha {
         image::RgbaImage::from_raw(width, height, rgba.to_vec())
@@ -184,8 +186,15 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[u8], with_alpha: 
 
 /// Writes an RGBA8 image (a contact sheet, a wedge) as a PNG, atomically.
 pub fn write_png_image(path: &Path, image: &image::RgbaImage) -> Result<()> {
-    if OutputFormat::from_path(path)? != OutputFormat::Png {
-        return Err(Error::input_file(path, "this output is a .png file"));
-    }
+    require_png(path)?;
     write_png(path, image.width(), image.height(), image.as_raw(), true)
+}
+
+/// Refuses an output path for a PNG-only image (a contact sheet, a wedge) that is not a `.png`:
+/// checked before the renders, so that a wrong name costs nothing.
+pub fn require_png(path: &Path) -> Result<()> {
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("png") => Ok(()),
+        _ => Err(Error::input_file(path, "this image is written only as PNG: name the output FILE.png")),
+    }
 }

@@ -67,7 +67,16 @@ impl Scene {
         };
         prepare_look(&mut look, &spec.sets)?;
         let settings = Settings::resolve(&look, &spec.overrides)?;
-        let environment = load_environment(settings.environment.as_ref(), &spec.env_options)?;
+        let environment = load_environment(settings.environment.as_ref(), &spec.env_options).map_err(|e| {
+            // An environment the look names is reported at the look's line, with the path it resolved to.
+            match (&spec.overrides.environment, &look.environment.source) {
+                (None, Some(EnvironmentRef::File(_))) => crate::Error {
+                    message: format!("{}: [environment] file: {}", look.place("environment.file"), e.message),
+                    ..e
+                },
+                _ => e,
+            }
+        })?;
         // read_gbuffer leaves the visibility out under --no-visibility, of a file and of the ball.
         let ReadGBuffer { gbuffer, name: gbuffer_name, claims } = read_gbuffer(&spec.gbuffer, &mut look, spec.quiet)?;
         claims.into_iter().for_each(crate::warn);
@@ -108,7 +117,8 @@ impl Scene {
         }
         if self.stacks.channels.len() as u32 > info.max_image_array_layers {
             return Err(crate::Error::input(format!(
-                "the look uses {} mask and map channels, more than {}'s {} image layers",
+                "{}: the look uses {} mask and map channels, more than {}'s {} image layers",
+                self.look.place(""),
                 self.stacks.channels.len(),
                 info.name,
                 info.max_image_array_layers

@@ -142,18 +142,17 @@ impl Settings {
 /// problem names where it came from: the flag, or the look's file.
 fn noise_threshold(look: &Look, overrides: &Overrides, spp: u32) -> Result<Option<NoiseThreshold>> {
     let render = &look.render;
-    let look_file = || look.file.as_deref().map_or("the look".to_string(), |f| f.display().to_string());
     let min_spp = match (overrides.min_spp, render.min_spp) {
         (Some(n), _) => Some((n, format!("--min-spp {n}"))),
-        (None, Some(n)) => Some((n, format!("{}: [render] min_spp = {n}", look_file()))),
+        (None, Some(n)) => Some((n, format!("{}: [render] min_spp = {n}", look.place("render.min_spp")))),
         (None, None) => None,
     };
     let threshold = overrides.noise_threshold.or(render.noise_threshold);
     match (threshold, min_spp) {
         (None, None) => Ok(None),
-        (None, Some((_, source))) => {
-            Err(Error::input(format!("{source}: only adaptive sampling (--noise-threshold) takes it")))
-        }
+        (None, Some((_, source))) => Err(Error::input(format!(
+            "{source}: only adaptive sampling takes it (a noise threshold: [render] noise_threshold, or --noise-threshold)"
+        ))),
         (Some(_), Some((min_spp, source))) if min_spp > spp => {
             Err(Error::input(format!("{source}: above spp, the most samples a pixel takes ({spp})")))
         }

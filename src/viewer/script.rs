@@ -453,7 +453,7 @@ pub fn zoom(text: &str) -> std::result::Result<Option<f32>, String> {
 }
 
 fn parameter(name: &str) -> std::result::Result<Param, String> {
-    Param::from_name(name).ok_or_else(|| format!("unknown parameter '{name}' (expected {})", Param::all_names()))
+    Param::parse(name)
 }
 
 fn number<T: std::str::FromStr>(text: &str, what: &str) -> std::result::Result<T, String> {

@@ -97,7 +97,7 @@ impl std::fmt::Display for Inspection {
             }
             write!(f, "; material")?;
             for param in crate::material::Param::ALL {
-                write!(f, " {}={}", param.name(), self.params.get(param))?;
+                write!(f, " {}={}", param.name(), self.params.get(param).short_text())?;
             }
         }
         let [r, g, b, a] = self.radiance;
