@@ -64,8 +64,8 @@ layout(set = 0, binding = 3, rgba32f) uniform writeonly image2D background;
 // With LOBE_AOVS, the running sums of each lobe's share: layers diffuse (with subsurface),
 // specular, clearcoat and sheen, all weighted as they enter the total.
 layout(set = 0, binding = 5, rgba32f) uniform image2DArray lobe_sums;
-// With VARIANCE_AOV, the running sum of each estimate's squared luminance (r), and 1 in g once
-// the pixel has stopped under a noise threshold.
+// With VARIANCE_AOV, the running sum of each estimate's squared luminance, scaled by
+// MOMENT_SCALE² (r), and 1 in g once the pixel has stopped under a noise threshold.
 layout(set = 0, binding = 6, rgba32f) uniform image2D moments;
 // The covered pixels, x | y << 16, row-major, read as a list: entry i is texel (i % width, i / width).
 layout(set = 0, binding = 7, r32ui) uniform readonly uimage2D covered;
@@ -113,6 +113,10 @@ const uint SOURCE_BACKGROUND = 3u;  // every pixel, row-major: the background on
 // Below this mean luminance the error is taken relative to it instead, as relative MSE adds
 // 0.01 to r²: dark pixels need no finer an absolute error, and black ones stop.
 const float BLACK = 0.1;
+// The luminances whose squares are summed are scaled by 2^-40 (exactly), so that the squares of
+// every radiance the bounds allow (up to 1e24, squared 1e48) stay finite in f32; what falls
+// below f32's range at the other end (under 1e-7) is far below BLACK.
+const float MOMENT_SCALE = 1.0 / 1099511627776.0;
 
 // R_y(−rotation)·d: world to environment space.
 vec3 to_environment(vec3 d) {
@@ -289,11 +293,12 @@ bool checkpoint(uint n) {
 // Whether the standard error of the mean luminance, from the sums of the estimates and of their
 // squared luminances (as Renderer::read_variance computes it), is below noise_threshold times
 // the mean. min_samples >= 2, so n > 1.
+// Both sums are in MOMENT_SCALE units, as the test is the same in any.
 bool converged(vec3 total, float squares, uint n) {
-    float sum = luminance(total);
+    float sum = luminance(total) * MOMENT_SCALE;
     float mean = sum / float(n);
     float variance = max(squares - sum * mean, 0.0) / (float(n) * float(n - 1u));
-    return sqrt(variance) < pass.noise_threshold * max(mean, BLACK);
+    return sqrt(variance) < pass.noise_threshold * max(mean, BLACK * MOMENT_SCALE);
 }
 
 // Adds samples first_sample .. first_sample + sample_count - 1 to a covered pixel.
@@ -330,7 +335,7 @@ void relight(ivec2 pixel, ivec2 size) {
             sum.rgb += emission;
             open_sum += emission;
             if (VARIANCE_AOV != 0u) {
-                float y = luminance(emission);
+                float y = luminance(emission) * MOMENT_SCALE;
                 squares += y * y;
             }
             if (adaptive && checkpoint(i + 1u) && converged(sum.rgb, squares, i + 1u)) {
@@ -371,7 +376,7 @@ void relight(ivec2 pixel, ivec2 size) {
             sum.rgb += x;
             open_sum += catcher ? emission + open : x;
             if (VARIANCE_AOV != 0u) {
-                float y = luminance(x);
+                float y = luminance(x) * MOMENT_SCALE;
                 squares += y * y;
             }
             if (adaptive && checkpoint(i + 1u) && converged(sum.rgb, squares, i + 1u)) {

@@ -290,6 +290,32 @@ fn finite_inputs_never_render_infinite_pixels() {
     for channel in &image.layer_data[0].channel_data.list {
         assert!(channel.sample_data.values_as_f32().all(f32::is_finite), "{:?} is not finite everywhere", channel.name);
     }
+
+    // The squared sums behind the variance AOV and adaptive sampling hold the brightest light
+    // the bounds allow: at 2^78 (a 2^59 texel at intensity 2^19) the variance AOV is finite and
+    // adaptive sampling takes as many samples as at 2^10 (bright enough that every pixel's
+    // error is relative), where they once overflowed, failing the AOV and stopping every pixel
+    // at --min-spp. Scaling by a power of two is exact, so the counts should match.
+    let mean_spp = |texel: f32, intensity: &str| {
+        let uniform = exr::prelude::SpecificChannels::rgb(move |_: exr::prelude::Vec2<usize>| (texel, texel, texel));
+        exr::prelude::Image::from_channels((16, 8), uniform).write().to_file(d.join("env.exr")).unwrap();
+        let args = [
+            "render", "--env", "env.exr", "--intensity", intensity, "--size", "48", "48", "--spp", "256",
+            "--noise-threshold", "0.1", "--aov", "variance", "--out", "v.exr",
+        ];
+        let run = lookdev_measured(d, &args, 60.0, None);
+        let text = stderr(&run.output);
+        assert!(run.output.status.success(), "{text}");
+        let image = exr::prelude::read_all_flat_layers_from_file(d.join("v.exr")).unwrap();
+        for channel in &image.layer_data[0].channel_data.list {
+            assert!(channel.sample_data.values_as_f32().all(f32::is_finite), "{:?} at {texel}: {text}", channel.name);
+        }
+        let mean: f64 = text.split(" spp on average").next().unwrap().rsplit(", ").next().unwrap().parse().unwrap();
+        mean
+    };
+    let (bright, brightest) = (mean_spp(1024.0, "1"), mean_spp(2f32.powi(59), "524288"));
+    assert!(bright > 17.0, "the scene needs more than --min-spp: {bright}");
+    assert!((brightest / bright - 1.0).abs() < 0.01, "{brightest} spp at 2^78 against {bright} at 2^10");
 }
 
 #[test]

@@ -884,10 +884,12 @@ impl Renderer {
     /// their squares: (Σx² − (Σx)²/n) / (n(n − 1)); zero with fewer than two samples. Needs
     /// [`Accumulate::variance`].
     pub fn read_variance(&self, coverage: &[f32]) -> Result<Vec<f32>> {
+        /// relight.comp's MOMENT_SCALE, 2^-40.
+        const MOMENT_SCALE: f64 = 1.0 / (1u64 << 40) as f64;
         assert!(self.relight.accumulate.variance, "read_variance() needs Accumulate::variance");
         let sums = self.read_sums()?;
         let squares: Vec<[f32; 4]> = bytemuck::cast_slice(&self.targets.moments.read(&self.ctx)?).to_vec();
-        Ok(sums
+        let variance: Vec<f64> = sums
             .iter()
             .zip(&squares)
             .zip(coverage)
@@ -897,9 +899,19 @@ impl Renderer {
                     return 0.0;
                 }
                 let total = crate::shading::common::luminance(glam::Vec3::new(sum[0], sum[1], sum[2])) as f64;
-                ((square[0] as f64 - total * total / n) / (n * (n - 1.0))).max(0.0) as f32
+                // The kernel sums squares of luminances scaled by MOMENT_SCALE (relight.comp).
+                let squares = square[0] as f64 / (MOMENT_SCALE * MOMENT_SCALE);
+                ((squares - total * total / n) / (n * (n - 1.0))).max(0.0)
             })
-            .collect())
+            .collect();
+        let beyond = variance.iter().filter(|&&v| v > f32::MAX as f64).count();
+        if beyond > 0 {
+            crate::warn(format!(
+                "the variance is beyond the largest 32-bit float at {beyond} pixels, which hold {:e} instead",
+                f32::MAX
+            ));
+        }
+        Ok(variance.into_iter().map(|v| v.min(f32::MAX as f64) as f32).collect())
     }
 
     /// The resolved material per pixel, as [`RESOLVED_LAYERS`] layers of vec4 in the layout of
