@@ -415,3 +415,91 @@ fn turntable_frames_carry_aovs() {
         assert_eq!(exr_text(&dir.path().join(frame), "lookdev/spp").as_deref(), Some("2"));
     }
 }
+
+/// An EXR's provenance re-renders it: its recorded look, rendered from another folder with its
+/// recorded flags, gives the same pixels, bit for bit, through every flag that changes the image.
+/// The look once dropped --rotation, --env, --intensity, --spp and the rest.
+#[test]
+fn the_recorded_look_and_flags_render_the_same_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let arg = |name: &str| d.join(name).to_string_lossy().into_owned();
+    assert_success(&lookdev(&["gbuffer", "--builtin", "shaderball", "--size", "32", "32", "--out", &arg("g.exr")]));
+    let sunrise = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/environment/sunrise.exr");
+    std::fs::copy(&sunrise, d.join("sky.exr")).unwrap();
+    std::fs::create_dir(d.join("shots")).unwrap();
+    std::fs::write(d.join("shots/shiny.toml"), "roughness = 0.15\nmetallic = 1\n").unwrap();
+    std::fs::write(
+        d.join("shots/look.toml"),
+        "[environment]\nrotation = 10\n[[object]]\n[[object.layer]]\npreset = \"shiny\"\n[[object.layer]]\npreset = \"gold\"\nmask = \"stripes\"\n",
+    )
+    .unwrap();
+    let sky = arg("sky.exr");
+    let cases: Vec<Vec<&str>> = vec![
+        vec!["--size", "32", "32", "--spp", "4", "--rotation", "33"],
+        vec![
+            "--size",
+            "24",
+            "16",
+            "--spp",
+            "3",
+            "--seed",
+            "9",
+            "--env",
+            "sunrise",
+            "--intensity",
+            "2.5",
+            "--exposure",
+            "1",
+        ],
+        vec![
+            "--size",
+            "32",
+            "32",
+            "--spp",
+            "8",
+            "--set",
+            "roughness=0.2",
+            "--model",
+            "specular_d=gtr",
+            "--model",
+            "gtr_gamma=1.5",
+        ],
+        vec!["--size", "32", "32", "--spp", "16", "--noise-threshold", "0.2", "--min-spp", "4", "--no-background"],
+        vec!["--size", "32", "32", "--spp", "4", "--sampling", "plain", "--tonemap", "aces", "--aov", "diffuse"],
+        vec!["--gbuffer", "g.exr", "--spp", "4", "--env", &sky, "--env-clamp", "--supersample", "2", "--no-visibility"],
+        vec!["--gbuffer", "g.exr", "--spp", "2", "--look", "shots/look.toml", "--rotation", "-45"],
+    ];
+    std::fs::create_dir(d.join("elsewhere")).unwrap();
+    for (i, flags) in cases.iter().enumerate() {
+        let out = arg(&format!("{i}.exr"));
+        let mut args = vec!["render", "--quiet", "--out", &out];
+        args.extend(flags);
+        let run =
+            std::process::Command::new(env!("CARGO_BIN_EXE_lookdev")).args(&args).current_dir(d).output().unwrap();
+        assert_success(&run);
+        let look = exr_text(Path::new(&out), "lookdev/look").unwrap();
+        let recorded_flags = exr_text(Path::new(&out), "lookdev/flags").unwrap();
+        // Saved and rendered elsewhere, with nothing but the recorded look and flags.
+        let saved = d.join("elsewhere").join(format!("{i}.toml"));
+        std::fs::write(&saved, &look).unwrap();
+        let again = arg(&format!("again-{i}.exr"));
+        let mut args = vec!["render", "--quiet", "--look", saved.to_str().unwrap(), "--out", &again];
+        args.extend(recorded_flags.split_whitespace());
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_lookdev"))
+            .args(&args)
+            .current_dir(d.join("elsewhere"))
+            .output()
+            .unwrap();
+        assert_success(&run);
+        assert!(
+            common::cli::exr_bits(Path::new(&out)) == common::cli::exr_bits(Path::new(&again)),
+            "case {i} ({flags:?}) does not re-render from its look ({recorded_flags}):\n{look}"
+        );
+        assert_eq!(
+            exr_text(Path::new(&again), "lookdev/look").as_deref(),
+            Some(look.as_str()),
+            "case {i}: the look is a fixed point"
+        );
+    }
+}

@@ -300,8 +300,22 @@ fn finite_inputs_never_render_infinite_pixels() {
         let uniform = exr::prelude::SpecificChannels::rgb(move |_: exr::prelude::Vec2<usize>| (texel, texel, texel));
         exr::prelude::Image::from_channels((16, 8), uniform).write().to_file(d.join("env.exr")).unwrap();
         let args = [
-            "render", "--env", "env.exr", "--intensity", intensity, "--size", "48", "48", "--spp", "256",
-            "--noise-threshold", "0.1", "--aov", "variance", "--out", "v.exr",
+            "render",
+            "--env",
+            "env.exr",
+            "--intensity",
+            intensity,
+            "--size",
+            "48",
+            "48",
+            "--spp",
+            "256",
+            "--noise-threshold",
+            "0.1",
+            "--aov",
+            "variance",
+            "--out",
+            "v.exr",
         ];
         let run = lookdev_measured(d, &args, 60.0, None);
         let text = stderr(&run.output);

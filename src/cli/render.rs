@@ -197,7 +197,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     })?;
     let settings = &scene.settings;
     let _timing = crate::timings::phase("write");
-    let metadata = Metadata::of_render(&scene.look, settings, &scene.environment);
+    let metadata = Metadata::of_render(&scene.look, settings, &scene.environment, &scene.recorded);
     match display {
         Some(aov) => write_aov_png(&args.out, &rendered, aov, settings)?,
         None => write(&args.out, format, &rendered, settings.lighting.background, &metadata)?,

@@ -144,7 +144,7 @@ fn render_frames(
             let path = pattern.path(frame);
             match format {
                 OutputFormat::Exr => {
-                    let metadata = Metadata::of_render(&scene.look, &settings, &scene.environment);
+                    let metadata = Metadata::of_render(&scene.look, &settings, &scene.environment, &scene.recorded);
                     let aovs = batch.aovs(&scene.look, &settings)?;
                     let radiance = batch.radiance()?;
                     let background = settings.lighting.background;

@@ -8,6 +8,7 @@ pub mod energy;
 pub mod output;
 pub mod passes;
 pub mod progressive;
+pub mod provenance;
 pub mod renderer;
 pub mod sampling;
 pub mod scene;

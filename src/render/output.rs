@@ -146,16 +146,20 @@ pub struct Metadata {
 }
 
 impl Metadata {
-    /// lookdev's version, the look (its TOML text), the BRDF model, the seed, the samples per
-    /// pixel, and the environment's file name and the hash of its content.
+    /// lookdev's version, the look as rendered (its TOML text, see
+    /// [`crate::render::provenance`]) and the flags no look holds, the BRDF model, the seed,
+    /// the samples per pixel, and the environment's file name and the hash of its content.
     pub fn of_render(
         look: &crate::material::Look,
         settings: &crate::render::settings::Settings,
         environment: &crate::environment::Environment,
+        recorded: &crate::render::provenance::Recorded,
     ) -> Metadata {
+        let rendered = crate::render::provenance::rendered_look(look, settings, recorded);
         let entries = [
             ("version", env!("CARGO_PKG_VERSION").to_string()),
-            ("look", look.to_toml()),
+            ("look", rendered.to_toml()),
+            ("flags", recorded.flags.join(" ")),
             ("model", settings.model.label()),
             ("seed", settings.seed.to_string()),
             ("spp", settings.spp.to_string()),

@@ -4,8 +4,10 @@
 use crate::environment::{Environment, EnvironmentRef, LoadOptions};
 use crate::gbuffer::source::{Source, SourceOptions};
 use crate::gbuffer::GBuffer;
+use crate::material::look::GBufferSettings;
 use crate::material::stack::{unused_stack_warnings, PackedStacks};
 use crate::material::{Look, Param, Value};
+use crate::render::provenance::{self, Recorded};
 use crate::render::settings::{Overrides, Settings};
 use crate::Result;
 use std::path::{Path, PathBuf};
@@ -54,6 +56,8 @@ pub struct Scene {
     pub environment: Environment,
     pub settings: Settings,
     pub stacks: PackedStacks,
+    /// What the render reads beyond the look and the settings, for the EXR's provenance.
+    pub recorded: Recorded,
 }
 
 impl Scene {
@@ -77,6 +81,7 @@ impl Scene {
                 _ => e,
             }
         })?;
+        let recorded = recorded(spec, &look, &settings);
         // read_gbuffer leaves the visibility out under --no-visibility, of a file and of the ball.
         let ReadGBuffer { gbuffer, name: gbuffer_name, claims } = read_gbuffer(&spec.gbuffer, &mut look, spec.quiet)?;
         claims.into_iter().for_each(crate::warn);
@@ -87,7 +92,7 @@ impl Scene {
         dark_render_warnings(&gbuffer, &gbuffer_name, &environment, settings.lighting.intensity)
             .into_iter()
             .for_each(crate::warn);
-        Ok(Scene { gbuffer, gbuffer_name, look, environment, settings, stacks })
+        Ok(Scene { gbuffer, gbuffer_name, look, environment, settings, stacks, recorded })
     }
 
     /// Whether this device can hold the g-buffer: checked once the device is known, and
@@ -125,6 +130,49 @@ impl Scene {
             )));
         }
         Ok(())
+    }
+}
+
+/// What `spec` reads beyond `look` and `settings` (see [`Recorded`]).
+fn recorded(spec: &SceneSpec, look: &Look, settings: &Settings) -> Recorded {
+    let g = &spec.gbuffer;
+    let file = g.file.clone().or_else(|| look.gbuffer.file.clone());
+    let mut flags = Vec::new();
+    if let (None, Some((width, height))) = (&file, g.builtin_size) {
+        flags.extend(["--size".to_string(), width.to_string(), height.to_string()]);
+    }
+    if let Some(factor) = g.supersample {
+        flags.extend(["--supersample".to_string(), factor.to_string()]);
+    }
+    if g.ignore_visibility {
+        flags.push("--no-visibility".into());
+    }
+    if spec.env_options.clamp_invalid {
+        flags.push("--env-clamp".into());
+    }
+    if spec.env_options.any_aspect {
+        flags.push("--env-any-aspect".into());
+    }
+    if settings.sampling != Default::default() {
+        flags.extend(["--sampling".to_string(), settings.sampling.name().to_string()]);
+    }
+    let aovs =
+        if spec.overrides.aovs.is_empty() { look.render.aovs.clone() } else { Some(spec.overrides.aovs.clone()) };
+    Recorded {
+        gbuffer: GBufferSettings {
+            file: file.as_deref().map(provenance::absolute),
+            source: SourceOptions {
+                occluders: g
+                    .source
+                    .occluders
+                    .clone()
+                    .or_else(|| look.gbuffer.source.occluders.clone())
+                    .map(|f| provenance::absolute(&f)),
+                ..g.source.over(&look.gbuffer.source)
+            },
+        },
+        aovs: aovs.filter(|a| !a.is_empty()),
+        flags,
     }
 }
 

@@ -190,6 +190,7 @@ impl Running {
             document,
             scene.environment,
             options.scene.env_options,
+            scene.recorded,
         )?;
         if let Some(path) = &options.compare_look {
             session.compare_look(path)?;

@@ -111,6 +111,8 @@ pub struct Session {
     pub gbuffer: GBuffer,
     /// The g-buffer's file, or "built-in shader ball".
     pub gbuffer_name: PathBuf,
+    /// What the scene reads beyond the look, for saved EXRs' provenance.
+    recorded: crate::render::provenance::Recorded,
     pub document: Document,
     renderer: Renderer,
     pub progressive: Progressive,
@@ -193,6 +195,7 @@ impl Session {
         document: Document,
         environment: Environment,
         env_options: LoadOptions,
+        recorded: crate::render::provenance::Recorded,
     ) -> Result<Session> {
         let objects = covered_object_ids(&gbuffer);
         let masks: Vec<String> = gbuffer.masks.keys().cloned().collect();
@@ -207,6 +210,7 @@ impl Session {
             progressive: Progressive::new(),
             gbuffer,
             gbuffer_name,
+            recorded,
             shown: Shown {
                 material_revision: document.material_revision(),
                 environment: settings.environment.clone(),
@@ -704,7 +708,7 @@ impl Session {
                 let radiance = self.renderer.read_radiance()?;
                 let environment = self.environments.iter().find(|(p, _)| *p == self.shown.environment).map(|(_, e)| e);
                 let metadata = environment
-                    .map(|e| output::Metadata::of_render(self.document.look(), &settings, e))
+                    .map(|e| output::Metadata::of_render(self.document.look(), &settings, e, &self.recorded))
                     .unwrap_or_default();
                 output::write_exr_with(
                     path,
@@ -844,8 +848,9 @@ impl Session {
         output::check_finite(Path::new("snapshot"), &radiance)?;
         let display = self.renderer.read_display(settings.exposure, settings.tonemap)?;
         let environment = self.environments.iter().find(|(p, _)| *p == self.shown.environment).map(|(_, e)| e);
-        let metadata =
-            environment.map(|e| output::Metadata::of_render(self.document.look(), &settings, e)).unwrap_or_default();
+        let metadata = environment
+            .map(|e| output::Metadata::of_render(self.document.look(), &settings, e, &self.recorded))
+            .unwrap_or_default();
         Ok(Capture {
             radiance,
             display,
