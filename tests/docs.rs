@@ -700,3 +700,40 @@ fn readme_packages_are_what_ci_installs() {
         assert!(ci_words.contains(package), "README.md asks for the package {package}, which .ci/run does not install");
     }
 }
+
+/// ... and every package `.ci/run` installs is one the README names, so that its prerequisites
+/// are all a fresh machine needs (Blender and the X11 libraries were once left out).
+#[test]
+fn ci_packages_are_what_the_readme_names() {
+    let readme = read(&repo().join("README.md"));
+    let ci = read(&repo().join(".ci/run"));
+    let list = ci.split_once("packages=(").and_then(|(_, rest)| rest.split_once(')')).map(|(list, _)| list);
+    let list = list.expect(".ci/run lists its packages as packages=( … )");
+    let packages: Vec<&str> = list.lines().flat_map(|l| strip_comment(l).split_whitespace()).collect();
+    assert!(packages.len() > 5, "{packages:?}");
+    let words: HashSet<&str> =
+        readme.split_whitespace().map(|w| w.trim_matches(|c: char| "`(),.;:".contains(c))).collect();
+    for package in packages {
+        assert!(words.contains(package), ".ci/run installs {package}, which README.md does not name");
+    }
+}
+
+/// A command shown inline in the README with its flags (`lookdev presets sheet --size 100 …`)
+/// parses as written: the gallery's sheet command once lacked its required --out.
+#[test]
+fn readme_inline_commands_parse() {
+    let (prose, _) = split_code(&read(&repo().join("README.md")));
+    let mut checked = 0;
+    for snippet in prose.split('`').skip(1).step_by(2) {
+        let words: Vec<&str> = snippet.split_whitespace().collect();
+        if words.first() != Some(&"lookdev") || !words.iter().any(|w| w.starts_with("--")) {
+            continue;
+        }
+        let args = words.iter().map(std::ffi::OsString::from);
+        if let Err(e) = lookdev::cli::parse(args) {
+            panic!("README.md: `{snippet}` does not parse: {e}");
+        }
+        checked += 1;
+    }
+    assert!(checked > 0, "the README shows no inline command with flags");
+}
