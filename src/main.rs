@@ -16,7 +16,12 @@ fn main() {
         }));
     }
     let place = || PANIC_PLACE.lock().ok().and_then(|mut place| place.take());
-    if let Err(error) = lookdev::cli::catching_panics(|| lookdev::cli::run(std::env::args_os()), place) {
+    let result = lookdev::cli::catching_panics(|| lookdev::cli::run(std::env::args_os()), place);
+    lookdev::timings::note(|| match lookdev::timings::host_peak_bytes() {
+        Some(bytes) => format!("host memory: peak {:.1} MiB (VmHWM)", bytes as f64 / (1 << 20) as f64),
+        None => "host memory: peak unknown".into(),
+    });
+    if let Err(error) = result {
         eprintln!("lookdev: error: {error}");
         std::process::exit(error.exit_code());
     }

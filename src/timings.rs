@@ -48,6 +48,15 @@ pub fn note(text: impl FnOnce() -> String) {
     }
 }
 
+/// The process's peak resident memory, VmHWM (Linux; None elsewhere): on a CPU driver it holds
+/// the device memory too.
+pub fn host_peak_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kib: u64 =
+        status.lines().find_map(|l| l.strip_prefix("VmHWM:"))?.trim().trim_end_matches(" kB").parse().ok()?;
+    Some(kib * 1024)
+}
+
 fn milliseconds(duration: Duration) -> f64 {
     duration.as_secs_f64() * 1e3
 }

@@ -136,6 +136,8 @@ pub fn run(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<()> {
         Parsed::Run(cli) => cli,
         Parsed::Print(text) => text.exit(),
     };
+    // This process is one command: what it reads are its inputs, which no output may replace.
+    crate::input::track_inputs();
     match cli.command {
         Command::Render(args) => render::run(args),
         Command::Gbuffer(args) => gbuffer::run(args),

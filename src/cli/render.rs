@@ -112,20 +112,28 @@ impl Rendered {
 
 /// Relights `scene` on `ctx` with `kernels` (specialised for the settings and `aovs`, see
 /// [`kernels_for`]) and reads back what the output needs: the radiance, the AOVs `aovs`, and
-/// the display pixels when `display` is set.
+/// the display pixels when `display` is set. With `last_use`, what only the upload needed is
+/// let go of once uploaded.
+#[allow(clippy::too_many_arguments)]
 fn render(
     ctx: &Context,
-    scene: &Scene,
+    scene: &mut Scene,
     kernels: KernelSource,
     aovs: &[Aov],
     display: bool,
     label: &str,
     quiet: bool,
+    last_use: bool,
 ) -> Result<Rendered> {
     scene.check_device(ctx.info())?;
     let settings = &scene.settings;
     let timing = crate::timings::phase("renderer");
     let mut renderer = Renderer::with_kernels(ctx, &scene.gbuffer, &scene.environment, settings.sampling, kernels)?;
+    // The device holds the visibility now; the host's copy, as large as the rest of the
+    // g-buffer or larger, is kept only for the occlusion AOV or another render of the scene.
+    if last_use && !aovs.contains(&Aov::Occlusion) {
+        scene.gbuffer.visibility = None;
+    }
     // The noise threshold before the AOVs: together they give the kernels' specialisation.
     renderer.set_noise_threshold(settings.noise)?;
     renderer.set_accumulate(aov::accumulate(aovs))?;
@@ -173,9 +181,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
     // The device opens while the scene loads, and the kernels compile while the scene uploads
     // (crate::render::startup).
     let options = ContextOptions::from_env(args.device.clone());
-    let (scene, rendered, device_name) = std::thread::scope(|threads| -> Result<_> {
+    let (scene, mut rendered, device_name) = std::thread::scope(|threads| -> Result<_> {
         let specialize = |scene: &Scene| kernels_for(scene, &output_aovs(format, display, &scene.settings));
-        let Started { scene, ctx, kernels } = startup::start(threads, &spec, options, specialize)?;
+        let Started { mut scene, ctx, kernels } = startup::start(threads, &spec, options, specialize)?;
         // Every input is read by now: refuse before the work, not after it.
         crate::input::refuse_replacing_input(&args.out)?;
         let counter = ctx.validation_counter();
@@ -190,7 +198,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         // Only a PNG of the beauty shows the display pixels.
         let beauty_png = format == OutputFormat::Png && display.is_none();
         let rendered =
-            render(&ctx, &scene, KernelSource::Pending(kernels), &aovs, beauty_png, "rendering", args.quiet)?;
+            render(&ctx, &mut scene, KernelSource::Pending(kernels), &aovs, beauty_png, "rendering", args.quiet, true)?;
         drop(ctx);
         super::check_validation(&counter)?;
         Ok((scene, rendered, device_name))
@@ -200,7 +208,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let metadata = Metadata::of_render(&scene.look, settings, &scene.environment, &scene.recorded);
     match display {
         Some(aov) => write_aov_png(&args.out, &rendered, aov, settings)?,
-        None => write(&args.out, format, &rendered, settings.lighting.background, &metadata)?,
+        None => write(&args.out, format, &mut rendered, settings.lighting.background, &metadata)?,
     }
     if !args.quiet {
         let spp = match rendered.stats.mean_spp {
@@ -279,11 +287,18 @@ fn encode(v: glam::Vec3) -> [u8; 3] {
     v.to_array().map(|c| (crate::shading::tonemap::srgb_encode(c.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8)
 }
 
-fn write(path: &Path, format: OutputFormat, rendered: &Rendered, background: bool, metadata: &Metadata) -> Result<()> {
+fn write(
+    path: &Path,
+    format: OutputFormat,
+    rendered: &mut Rendered,
+    background: bool,
+    metadata: &Metadata,
+) -> Result<()> {
     let (width, height) = (rendered.width, rendered.height);
+    let aovs = std::mem::take(&mut rendered.aovs);
     match (format, &rendered.radiance) {
         (OutputFormat::Exr, Some(radiance)) => {
-            output::write_exr_with(path, width, height, radiance, background, &rendered.aovs, &metadata.entries)
+            output::write_exr_with(path, width, height, radiance, background, aovs, &metadata.entries)
         }
         (_, radiance) => {
             // The display pixels are 8-bit; the radiance behind them shows whether any is not finite.
@@ -339,12 +354,17 @@ fn run_compare(args: &RenderArgs, format: OutputFormat, second_look: Option<&Pat
     let counter = ctx.validation_counter();
     let device_name = ctx.info().name.clone();
     let kernels = |scene: &Scene| KernelSource::Compile(kernels_for(scene, &[]));
-    let first = render(&ctx, &a, kernels(&a), &[], true, "rendering A", args.quiet)?;
+    let a_kernels = kernels(&a);
+    let first = render(&ctx, &mut a, a_kernels, &[], true, "rendering A", args.quiet, false)?;
     let second = match second_scene {
-        Second::Look(b) => render(&ctx, &b, kernels(&b), &[], true, "rendering B", args.quiet)?,
+        Second::Look(mut b) => {
+            let b_kernels = kernels(&b);
+            render(&ctx, &mut b, b_kernels, &[], true, "rendering B", args.quiet, true)?
+        }
         Second::Model(model) => {
             a.settings.model = model;
-            render(&ctx, &a, kernels(&a), &[], true, "rendering B", args.quiet)?
+            let a_kernels = kernels(&a);
+            render(&ctx, &mut a, a_kernels, &[], true, "rendering B", args.quiet, true)?
         }
     };
     drop(ctx);

@@ -148,7 +148,7 @@ fn render_frames(
                     let aovs = batch.aovs(&scene.look, &settings)?;
                     let radiance = batch.radiance()?;
                     let background = settings.lighting.background;
-                    output::write_exr_with(&path, width, height, &radiance, background, &aovs, &metadata.entries)?
+                    output::write_exr_with(&path, width, height, &radiance, background, aovs, &metadata.entries)?
                 }
                 OutputFormat::Png => {
                     output::check_finite(&path, &batch.radiance()?)?;

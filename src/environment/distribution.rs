@@ -276,10 +276,15 @@ impl Distribution {
     /// Writes the texels as the GPU stores them, row-major: each one's radiance from `env`, and
     /// its cell's pdf_ω in a, so that one fetch gives both.
     pub fn write_texels(&self, env: &Environment, out: &mut [[f32; 4]]) {
-        for (y, (texels, row)) in
-            env.texels.chunks(self.width as usize).zip(out.chunks_mut(self.width as usize)).enumerate()
-        {
-            let pdfs = &self.cell_pdf[(y as u32 / self.block_y * self.columns) as usize..];
+        self.write_texel_rows(env, 0, out);
+    }
+
+    /// [`Distribution::write_texels`] for the rows from `first_row` on, as many as `out` holds.
+    pub fn write_texel_rows(&self, env: &Environment, first_row: u32, out: &mut [[f32; 4]]) {
+        let width = self.width as usize;
+        let texels = &env.texels[first_row as usize * width..];
+        for (y, (texels, row)) in (first_row..).zip(texels.chunks(width).zip(out.chunks_mut(width))) {
+            let pdfs = &self.cell_pdf[(y / self.block_y * self.columns) as usize..];
             for (x, (t, texel)) in texels.iter().zip(row).enumerate() {
                 *texel = [t[0], t[1], t[2], pdfs[x / self.block_x as usize]];
             }

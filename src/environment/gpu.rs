@@ -64,7 +64,9 @@ impl GpuEnvironment {
             ));
         }
         let (rgba, r32) = (vk::Format::R32G32B32A32_SFLOAT, vk::Format::R32_SFLOAT);
-        let texels = Image::filled(ctx, rgba, env.width, env.height, |out| distribution.write_texels(env, out))?;
+        let texels = Image::filled_rows(ctx, rgba, env.width, env.height, |first_row, out| {
+            distribution.write_texel_rows(env, first_row, out)
+        })?;
         let (width, height) = distribution.table_size();
         let buckets = match samplers {
             Samplers::Product(_) => placeholder(ctx, rgba)?,

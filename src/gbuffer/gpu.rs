@@ -43,12 +43,21 @@ pub struct StackIndex {
 impl GpuGBuffer {
     pub fn upload(ctx: &Context, gbuffer: &GBuffer) -> Result<GpuGBuffer> {
         let (width, height) = (gbuffer.width, gbuffer.height);
-        let mut surface_data = Vec::with_capacity(3 * gbuffer.pixel_count());
-        surface_data.extend(gbuffer.normal.iter().zip(&gbuffer.coverage).map(|(n, a)| [n[0], n[1], n[2], *a]));
-        surface_data.extend(gbuffer.view.iter().map(|v| [v[0], v[1], v[2], 0.0]));
-        surface_data.extend(gbuffer.tangent.iter().map(|t| [t[0], t[1], t[2], 0.0]));
+        // Written straight into the staging memory, a band of rows at a time: no third copy.
         let surface = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, 3, true)?;
-        surface.upload(ctx, bytemuck::cast_slice(&surface_data))?;
+        surface.upload_rows(ctx, |layer, first_row, bytes| {
+            let out: &mut [[f32; 4]] = bytemuck::cast_slice_mut(bytes);
+            let start = first_row as usize * width as usize;
+            let pixels = start..start + out.len();
+            match layer {
+                0 => {
+                    let normals = gbuffer.normal[pixels.clone()].iter().zip(&gbuffer.coverage[pixels]);
+                    out.iter_mut().zip(normals).for_each(|(o, (n, a))| *o = [n[0], n[1], n[2], *a]);
+                }
+                1 => out.iter_mut().zip(&gbuffer.view[pixels]).for_each(|(o, v)| *o = [v[0], v[1], v[2], 0.0]),
+                _ => out.iter_mut().zip(&gbuffer.tangent[pixels]).for_each(|(o, t)| *o = [t[0], t[1], t[2], 0.0]),
+            }
+        })?;
         let object_ids = Image::new(ctx, vk::Format::R32_UINT, width, height, 1, false)?;
         object_ids.upload(ctx, bytemuck::cast_slice(&gbuffer.object_id))?;
         let (visibility, visibility_side) = upload_visibility(ctx, gbuffer)?;
@@ -86,15 +95,20 @@ impl GpuGBuffer {
     /// layer, so the binding is always valid); uploaded only when the list changes.
     fn channel_layers(&mut self, ctx: &Context, packed: &PackedStacks) -> Result<&Image> {
         if self.channel_layers.as_ref().is_none_or(|(names, _)| *names != packed.channels) {
-            let pixels = self.ids.len();
             let layers = packed.channels.len().max(1) as u32;
-            let mut data = vec![0.0f32; pixels * layers as usize];
-            for (i, name) in packed.channels.iter().enumerate() {
-                let values = self.channels.get(name).expect("pack() checked the masks and maps");
-                data[i * pixels..(i + 1) * pixels].copy_from_slice(values);
-            }
             let image = Image::new(ctx, vk::Format::R32_SFLOAT, self.width, self.height, layers, true)?;
-            image.upload(ctx, bytemuck::cast_slice(&data))?;
+            let width = self.width as usize;
+            image.upload_rows(ctx, |layer, first_row, bytes| {
+                let out: &mut [f32] = bytemuck::cast_slice_mut(bytes);
+                match packed.channels.get(layer as usize) {
+                    Some(name) => {
+                        let values = self.channels.get(name).expect("pack() checked the masks and maps");
+                        let start = first_row as usize * width;
+                        out.copy_from_slice(&values[start..start + out.len()]);
+                    }
+                    None => out.fill(0.0),
+                }
+            })?;
             self.channel_layers = Some((packed.channels.clone(), image));
         }
         Ok(&self.channel_layers.as_ref().expect("just made").1)
@@ -127,12 +141,15 @@ fn upload_visibility(ctx: &Context, gbuffer: &GBuffer) -> Result<(Image, u32)> {
     let words = visibility.grid.words();
     let per_pixel = words.div_ceil(4);
     let rows = visibility_rows(gbuffer.pixel_count(), visibility.grid) as u32;
-    let image = Image::filled(ctx, vk::Format::R32G32B32A32_UINT, VISIBILITY_ROW, rows, |out: &mut [[u32; 4]]| {
-        out.fill([0; 4]);
-        for (pixel, bits) in visibility.words.chunks_exact(words).enumerate() {
-            for (k, chunk) in bits.chunks(4).enumerate() {
-                out[pixel * per_pixel + k][..chunk.len()].copy_from_slice(chunk);
-            }
+    let format = vk::Format::R32G32B32A32_UINT;
+    let image = Image::filled_rows(ctx, format, VISIBILITY_ROW, rows, |first_row, out: &mut [[u32; 4]]| {
+        let first = first_row as usize * VISIBILITY_ROW as usize;
+        for (texel, out) in (first..).zip(out.iter_mut()) {
+            let (pixel, k) = (texel / per_pixel, texel % per_pixel);
+            let bits = visibility.words.get(pixel * words..(pixel + 1) * words).unwrap_or_default();
+            let chunk = bits.get(4 * k..(4 * k + 4).min(bits.len())).unwrap_or_default();
+            *out = [0; 4];
+            out[..chunk.len()].copy_from_slice(chunk);
         }
     })?;
     Ok((image, visibility.grid.side()))

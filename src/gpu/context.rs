@@ -133,6 +133,8 @@ pub(crate) struct Shared {
     /// Serialises [`Context::run`]: the command pool and the queue must not be used from two
     /// threads at once.
     submission: std::sync::Mutex<()>,
+    /// The device memory the buffers and images hold.
+    pub(crate) memory: super::memory::MemoryUse,
 }
 
 impl Shared {
@@ -144,6 +146,7 @@ impl Shared {
 
 impl Drop for Shared {
     fn drop(&mut self) {
+        crate::timings::note(|| format!("device memory: peak {:.1} MiB", self.memory.peak() as f64 / (1 << 20) as f64));
         // Destroying a null handle does nothing, so a half-made context drops cleanly.
         unsafe {
             let _ = self.device.device_wait_idle();
@@ -251,6 +254,11 @@ impl Context {
 
     pub fn info(&self) -> &DeviceInfo {
         &self.shared.info
+    }
+
+    /// The device memory this context's buffers and images hold, now and at the most.
+    pub fn memory(&self) -> &super::memory::MemoryUse {
+        &self.shared.memory
     }
 
     /// Records commands with `record`, submits them and waits. A full memory barrier before
@@ -452,6 +460,7 @@ fn create_device(instance: Arc<Instance>, options: &ContextOptions, surface: Opt
         command_pool: vk::CommandPool::null(),
         pipeline_cache: None,
         submission: std::sync::Mutex::new(()),
+        memory: Default::default(),
     };
     let pool_info = vk::CommandPoolCreateInfo::default()
         .queue_family_index(queue_family)

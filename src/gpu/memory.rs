@@ -17,6 +17,8 @@ fn find_memory_type(shared: &Shared, type_bits: u32, wanted: vk::MemoryPropertyF
         .find(|&i| type_bits & (1 << i) != 0 && props.memory_types[i as usize].property_flags.contains(wanted))
 }
 
+/// Allocates memory for one resource and counts it in [`Shared::memory`]; the resource gives it
+/// back with [`free`].
 fn allocate(shared: &Shared, requirements: vk::MemoryRequirements, host_visible: bool) -> Result<vk::DeviceMemory> {
     let preferred = if host_visible {
         vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT
@@ -31,8 +33,49 @@ fn allocate(shared: &Shared, requirements: vk::MemoryRequirements, host_visible:
         })
         .ok_or_else(|| Error::gpu("no suitable Vulkan memory type"))?;
     let info = vk::MemoryAllocateInfo::default().allocation_size(requirements.size).memory_type_index(type_index);
-    unsafe { shared.device.allocate_memory(&info, None) }
-        .map_err(|e| Error::gpu(format!("cannot allocate {} MiB of GPU memory ({e})", requirements.size >> 20)))
+    let memory = unsafe { shared.device.allocate_memory(&info, None) }
+        .map_err(|e| Error::gpu(format!("cannot allocate {} MiB of GPU memory ({e})", requirements.size >> 20)))?;
+    shared.memory.add(requirements.size);
+    Ok(memory)
+}
+
+/// Frees what [`allocate`] gave, `size` bytes (a null handle, from a resource half made, is
+/// nothing to free).
+fn free(shared: &Shared, memory: vk::DeviceMemory, size: u64) {
+    if memory != vk::DeviceMemory::null() {
+        unsafe { shared.device.free_memory(memory, None) };
+        shared.memory.remove(size);
+    }
+}
+
+/// The device memory a context holds, now and at its most, for `LOOKDEV_TIMINGS=1` and the
+/// memory benchmark.
+#[derive(Debug, Default)]
+pub struct MemoryUse {
+    current: std::sync::atomic::AtomicU64,
+    peak: std::sync::atomic::AtomicU64,
+}
+
+impl MemoryUse {
+    fn add(&self, bytes: u64) {
+        use std::sync::atomic::Ordering::Relaxed;
+        let now = self.current.fetch_add(bytes, Relaxed) + bytes;
+        self.peak.fetch_max(now, Relaxed);
+    }
+
+    fn remove(&self, bytes: u64) {
+        self.current.fetch_sub(bytes, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// The bytes allocated now.
+    pub fn current(&self) -> u64 {
+        self.current.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// The most bytes allocated at once so far.
+    pub fn peak(&self) -> u64 {
+        self.peak.load(std::sync::atomic::Ordering::Relaxed)
+    }
 }
 
 /// A storage, staging or vertex buffer.
@@ -40,6 +83,8 @@ pub struct Buffer {
     shared: Arc<Shared>,
     pub buffer: vk::Buffer,
     memory: vk::DeviceMemory,
+    /// The bytes `memory` holds, as allocated.
+    allocated: u64,
     pub size: u64,
     mapped: Option<*mut u8>,
 }
@@ -74,11 +119,18 @@ impl Buffer {
         let info = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
         let buffer = unsafe { ctx.shared.device.create_buffer(&info, None) }?;
         // From here on, Drop releases whatever has been created if a later step fails.
-        let mut result =
-            Buffer { shared: ctx.shared.clone(), buffer, memory: vk::DeviceMemory::null(), size, mapped: None };
+        let mut result = Buffer {
+            shared: ctx.shared.clone(),
+            buffer,
+            memory: vk::DeviceMemory::null(),
+            allocated: 0,
+            size,
+            mapped: None,
+        };
         let device = &result.shared.device;
         let requirements = unsafe { device.get_buffer_memory_requirements(buffer) };
         result.memory = allocate(&result.shared, requirements, host_visible)?;
+        result.allocated = requirements.size;
         unsafe { device.bind_buffer_memory(buffer, result.memory, 0) }?;
         if host_visible {
             let pointer = unsafe { device.map_memory(result.memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty()) }?;
@@ -146,8 +198,8 @@ impl Drop for Buffer {
                 self.shared.device.unmap_memory(self.memory);
             }
             self.shared.device.destroy_buffer(self.buffer, None);
-            self.shared.device.free_memory(self.memory, None);
         }
+        free(&self.shared, self.memory, self.allocated);
     }
 }
 
@@ -202,6 +254,8 @@ pub struct Image {
     /// For an 8-bit display image: a view that samples it as sRGB (decoding to linear).
     pub srgb_view: vk::ImageView,
     memory: vk::DeviceMemory,
+    /// The bytes `memory` holds, as allocated.
+    allocated: u64,
     pub format: vk::Format,
     pub width: u32,
     pub height: u32,
@@ -210,6 +264,9 @@ pub struct Image {
     levels: u32,
     aspect: vk::ImageAspectFlags,
 }
+
+/// The most staging memory one upload holds at once ([`Image::upload_rows`]).
+pub const UPLOAD_CHUNK: u64 = 64 << 20;
 
 /// Bytes per texel of the formats lookdev uses.
 pub fn texel_size(format: vk::Format) -> u64 {
@@ -233,6 +290,20 @@ impl Image {
 
     /// A storage image of one layer whose texels `fill` writes, row-major, straight into the
     /// memory the transfer copies from: no other copy of them is made on the host.
+    /// A one-layer image whose texels `fill(first_row, texels)` writes a band of rows at a time
+    /// ([`Image::upload_rows`]).
+    pub fn filled_rows<T: bytemuck::Pod>(
+        ctx: &Context,
+        format: vk::Format,
+        width: u32,
+        height: u32,
+        mut fill: impl FnMut(u32, &mut [T]),
+    ) -> Result<Image> {
+        let image = Image::create(ctx, format, width, height, 1, false, Purpose::Filled, 1)?;
+        image.upload_rows(ctx, |_, first_row, bytes| fill(first_row, bytemuck::cast_slice_mut(bytes)))?;
+        Ok(image)
+    }
+
     pub fn filled<T: bytemuck::Pod>(
         ctx: &Context,
         format: vk::Format,
@@ -342,6 +413,7 @@ impl Image {
             view: vk::ImageView::null(),
             srgb_view: vk::ImageView::null(),
             memory: vk::DeviceMemory::null(),
+            allocated: 0,
             format,
             width,
             height,
@@ -352,6 +424,7 @@ impl Image {
         let device = &result.shared.device;
         let requirements = unsafe { device.get_image_memory_requirements(image) };
         result.memory = allocate(&result.shared, requirements, false)?;
+        result.allocated = requirements.size;
         unsafe { device.bind_image_memory(image, result.memory, 0) }?;
         let view_type = if array || layers > 1 { vk::ImageViewType::TYPE_2D_ARRAY } else { vk::ImageViewType::TYPE_2D };
         let view_info = vk::ImageViewCreateInfo::default()
@@ -432,7 +505,49 @@ impl Image {
     /// Fills every layer from tightly packed texels, layer after layer, rows top to bottom.
     pub fn upload(&self, ctx: &Context, data: &[u8]) -> Result<()> {
         assert_eq!(data.len() as u64, self.byte_size(), "upload size must match the image");
-        self.upload_with(ctx, |bytes| bytes.copy_from_slice(data))
+        let row_bytes = (self.width as u64 * texel_size(self.format)) as usize;
+        let layer_bytes = row_bytes * self.height as usize;
+        self.upload_rows(ctx, |layer, first_row, bytes| {
+            let start = layer as usize * layer_bytes + first_row as usize * row_bytes;
+            bytes.copy_from_slice(&data[start..start + bytes.len()]);
+        })
+    }
+
+    /// Fills the image a band of rows at a time through one staging buffer of at most
+    /// [`UPLOAD_CHUNK`] bytes (a row at the least), so that a large image never has a whole
+    /// second copy in staging memory: `fill(layer, first_row, bytes)` writes that layer's rows
+    /// from `first_row` on, as many as `bytes` holds, tightly packed.
+    pub fn upload_rows(&self, ctx: &Context, fill: impl FnMut(u32, u32, &mut [u8])) -> Result<()> {
+        self.upload_rows_within(ctx, UPLOAD_CHUNK, fill)
+    }
+
+    /// [`Image::upload_rows`] through at most `chunk` bytes of staging (a row at the least).
+    pub fn upload_rows_within(
+        &self,
+        ctx: &Context,
+        chunk: u64,
+        mut fill: impl FnMut(u32, u32, &mut [u8]),
+    ) -> Result<()> {
+        let row_bytes = self.width as u64 * texel_size(self.format);
+        let band = (chunk / row_bytes).clamp(1, self.height as u64) as u32;
+        let mut staging = Buffer::staging(ctx, band as u64 * row_bytes)?;
+        for layer in 0..self.layers {
+            for first_row in (0..self.height).step_by(band as usize) {
+                let rows = band.min(self.height - first_row);
+                fill(layer, first_row, &mut staging.bytes_mut()[..(rows as u64 * row_bytes) as usize]);
+                let region = vk::BufferImageCopy::default()
+                    .image_subresource(
+                        vk::ImageSubresourceLayers::default()
+                            .aspect_mask(self.aspect)
+                            .base_array_layer(layer)
+                            .layer_count(1),
+                    )
+                    .image_offset(vk::Offset3D { x: 0, y: first_row as i32, z: 0 })
+                    .image_extent(vk::Extent3D { width: self.width, height: rows, depth: 1 });
+                self.copy_from(ctx, &staging, &[region])?;
+            }
+        }
+        Ok(())
     }
 
     /// Fills every layer with the texels `fill` writes into the staging memory, laid out as
@@ -514,7 +629,7 @@ impl Drop for Image {
             self.shared.device.destroy_image_view(self.srgb_view, None);
             self.shared.device.destroy_image_view(self.view, None);
             self.shared.device.destroy_image(self.image, None);
-            self.shared.device.free_memory(self.memory, None);
         }
+        free(&self.shared, self.memory, self.allocated);
     }
 }

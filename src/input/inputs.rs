@@ -5,6 +5,7 @@
 use super::Kind;
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
 /// One input read: where it lives on disk and what it was read as.
@@ -17,8 +18,20 @@ struct Input {
 
 static READ: Mutex<Vec<Input>> = Mutex::new(Vec::new());
 
+/// Whether reads are noted: only in a process that runs one command (`lookdev …`), whose reads
+/// are that command's inputs; a program using the library reads and writes as it likes.
+static TRACKING: AtomicBool = AtomicBool::new(false);
+
+/// From now on, notes every file read as an input of this process's command.
+pub fn track_inputs() {
+    TRACKING.store(true, Ordering::Relaxed);
+}
+
 /// Notes that `path`, whose opened handle has `meta`, was read as `kind`.
 pub(super) fn record(path: &Path, meta: &std::fs::Metadata, kind: Kind) {
+    if !TRACKING.load(Ordering::Relaxed) {
+        return;
+    }
     let Some((device, inode)) = identity(meta) else { return };
     let Ok(mut read) = READ.lock() else { return };
     if !read.iter().any(|i| i.device == device && i.inode == inode) {
@@ -69,6 +82,7 @@ mod tests {
         std::fs::write(&other, "").unwrap();
         let link = dir.path().join("link.toml");
         std::fs::hard_link(&input, &link).unwrap();
+        track_inputs();
         assert!(refuse_replacing_input(&input).is_ok(), "not read yet");
         super::super::read_text(&input, Kind::Toml).unwrap();
         for name in [&input, &link] {

@@ -16,7 +16,7 @@ pub mod image;
 mod inputs;
 pub mod readers;
 
-pub use inputs::refuse_replacing_input;
+pub use inputs::{refuse_replacing_input, track_inputs};
 
 use crate::{Error, Result};
 use std::fs::File;

@@ -37,7 +37,7 @@ pub fn check_finite(path: &Path, radiance: &[[f32; 4]]) -> Result<()> {
 /// Writes linear radiance as a float RGBA EXR. With a background, alpha is 1; without, it is the
 /// coverage and the colour is premultiplied by it, as compositors expect.
 pub fn write_exr(path: &Path, width: u32, height: u32, radiance: &[[f32; 4]], background: bool) -> Result<()> {
-    write_exr_with(path, width, height, radiance, background, &[], &[])
+    write_exr_with(path, width, height, radiance, background, Vec::new(), &[])
 }
 
 /// [`write_exr`], with AOV layers beside the beauty (`<layer>.R .G .B` or `.Y`) and text
@@ -48,7 +48,7 @@ pub fn write_exr_with(
     height: u32,
     radiance: &[[f32; 4]],
     background: bool,
-    layers: &[crate::render::aov::Layer],
+    layers: Vec<crate::render::aov::Layer>,
     attributes: &[(String, String)],
 ) -> Result<()> {
     use exr::prelude::{
@@ -57,7 +57,7 @@ pub fn write_exr_with(
     };
     crate::input::refuse_replacing_input(path)?;
     check_finite(path, radiance)?;
-    for layer in layers {
+    for layer in &layers {
         for (channel, values) in &layer.channels {
             if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
                 return Err(Error::gpu(format!(
@@ -78,8 +78,10 @@ pub fn write_exr_with(
     let beauty = ["R", "G", "B", "A"].iter().enumerate().map(|(k, name)| {
         channel(name, radiance.iter().map(|p| if k == 3 && background { 1.0 } else { p[k] }).collect())
     });
-    let aovs = layers.iter().flat_map(|layer| {
-        layer.channels.iter().map(|(name, values)| channel(&format!("{}.{name}", layer.name), values.clone()))
+    // Moved, not copied: an image with every AOV is several times the beauty.
+    let aovs = layers.into_iter().flat_map(|layer| {
+        let name = layer.name;
+        layer.channels.into_iter().map(move |(channel_name, values)| channel(&format!("{name}.{channel_name}"), values))
     });
     let channels: Vec<AnyChannel<FlatSamples>> = beauty.chain(aovs).collect();
     let mut layer_attributes = LayerAttributes { software_name: Some(text("lookdev")), ..LayerAttributes::default() };

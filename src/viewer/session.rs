@@ -716,7 +716,7 @@ impl Session {
                     height,
                     &radiance,
                     settings.lighting.background,
-                    &[],
+                    Vec::new(),
                     &metadata.entries,
                 )?;
             }

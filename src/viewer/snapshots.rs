@@ -205,7 +205,7 @@ impl Snapshots {
             height,
             &capture.radiance,
             capture.background,
-            &[],
+            Vec::new(),
             &capture.metadata,
         )?;
         output::write_png(&path("png"), width, height, &capture.display, !capture.background)?;

@@ -395,9 +395,16 @@ mod tests {
         let scene = Scene::load(&spec).unwrap();
         let mut document = Document::new(scene.look.clone(), None, scene.settings.clone());
         document.select(Selection { object: Some(ObjectRef::Id(1)), layer: Some(0) });
-        let session =
-            Session::new(&ctx, scene.gbuffer, scene.gbuffer_name, document, scene.environment, Default::default())
-                .unwrap();
+        let session = Session::new(
+            &ctx,
+            scene.gbuffer,
+            scene.gbuffer_name,
+            document,
+            scene.environment,
+            Default::default(),
+            scene.recorded,
+        )
+        .unwrap();
         let egui = egui::Context::default();
         let mut actions = Vec::new();
         let mut shown = Vec::new();
