@@ -453,6 +453,56 @@ fn the_selection_stays_within_its_stack() {
     assert_eq!(doc.selection().layer, Some(1));
 }
 
+/// The selection is a layer, not an index: it follows its layer through duplicate, undo, redo
+/// and moves, and a duplicate takes it. Once, `select 1 0`, `duplicate`, `undo`, `select 1 1`,
+/// `redo`, `hide` hid the copy of blue-rubber, not the selected gold.
+#[test]
+fn the_selection_follows_its_layer_through_edits_undo_and_redo() {
+    let mut doc = document();
+    let selected = |doc: &Document| {
+        let layer = doc.selection().layer.unwrap();
+        doc.stack(BALL).unwrap().layers[layer].preset.clone().unwrap()
+    };
+    doc.select(Selection { object: Some(BALL), layer: Some(0) });
+    doc.apply(Edit::DuplicateLayer { object: BALL, layer: 0 }).unwrap();
+    assert_eq!(doc.selection().layer, Some(1), "the copy is selected");
+    doc.undo();
+    doc.select(Selection { object: Some(BALL), layer: Some(1) });
+    assert_eq!(selected(&doc), "gold");
+    doc.redo();
+    assert_eq!(
+        (doc.selection().layer, selected(&doc)),
+        (Some(2), "gold".to_string()),
+        "gold moved up; so did the selection"
+    );
+    let layer = doc.selection().layer.unwrap();
+    doc.apply(Edit::SetEnabled { object: BALL, layer, enabled: false }).unwrap();
+    let stack = doc.stack(BALL).unwrap();
+    assert!(!stack.layers[2].enabled && stack.layers[..2].iter().all(|l| l.enabled), "gold is hidden, nothing else");
+    doc.apply(Edit::MoveLayer { object: BALL, from: 2, to: 0 }).unwrap();
+    assert_eq!((doc.selection().layer, selected(&doc)), (Some(0), "gold".to_string()), "a move takes it along");
+    doc.undo();
+    assert_eq!(selected(&doc), "gold");
+}
+
+/// A click on the object already selected keeps its layer (the next slider edit once went to
+/// the top layer instead); a click on another object selects that object's top layer.
+#[test]
+fn picking_the_selected_object_keeps_its_layer() {
+    let mut doc = document();
+    doc.select(Selection { object: Some(BALL), layer: Some(0) });
+    doc.select_object(BALL);
+    assert_eq!(doc.selection(), Selection { object: Some(BALL), layer: Some(0) });
+    doc.select_object(ObjectRef::Id(2));
+    assert_eq!(
+        doc.selection(),
+        Selection { object: Some(ObjectRef::Id(2)), layer: Some(0) },
+        "the default stack's top"
+    );
+    doc.select_object(BALL);
+    assert_eq!(doc.selection(), Selection { object: Some(BALL), layer: Some(2) }, "another object: its top layer");
+}
+
 // ---- Presets: resolution, overrides, reset. ----
 
 #[test]

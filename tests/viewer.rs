@@ -532,10 +532,12 @@ fn script_and_display_problems_are_clear_errors() {
     assert_eq!(output.status.code(), Some(2));
     let text = stderr(&output);
     assert!(text.contains("mask.script:2: the g-buffer has no mask 'nosuch'") && !text.contains("panicked"), "{text}");
-    case.write("wait.script", "wait-spp 50\n");
+    case.write("wait.script", "spp 100\nwait-spp 50\n");
     let output = case.view(&["--script", "wait.script", "--exit-after-spp", "2"]);
     assert_eq!(output.status.code(), Some(2));
-    assert!(stderr(&output).contains("wait.script:1: wait-spp 50 would never end"), "{}", stderr(&output));
+    let text = stderr(&output);
+    assert!(text.contains("wait.script:2: wait-spp 50 would never end: --exit-after-spp 2 stops the viewer"), "{text}");
+    assert!(!text.contains("raise it with `spp"), "the script's spp is not what caps it: {text}");
 
     // No display, or one that cannot be reached.
     let output = case.command(&["view"]).env_remove("DISPLAY").output().unwrap();

@@ -159,6 +159,29 @@ pub struct Layer {
     /// The 1-based line of this `[[object.layer]]` in the file, for later error messages
     /// (such as a mask the g-buffer lacks).
     pub line: usize,
+    /// Which layer this is, while the program runs: kept by clones (an undo step's copy of a
+    /// stack holds the same layers), new for every layer made or duplicated. Not saved, and not
+    /// part of what the layer means.
+    pub id: LayerId,
+}
+
+/// A layer's identity while the program runs ([`Layer::id`]), so that a selection follows its
+/// layer through edits, undo and redo however the stack's order changes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct LayerId(u64);
+
+impl LayerId {
+    /// An identity no other layer has.
+    pub fn new() -> LayerId {
+        static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+        LayerId(NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
+    }
+}
+
+impl Default for LayerId {
+    fn default() -> LayerId {
+        LayerId::new()
+    }
 }
 
 impl Layer {
@@ -175,12 +198,14 @@ impl Layer {
             opacity: 1.0,
             enabled: true,
             line: 0,
+            id: LayerId::new(),
         }
     }
 }
 
-/// Layers are equal when they mean the same. `line` records where one was written, not what
-/// it means, so it is left out: that is what lets `parse(to_toml(look)) == look` hold.
+/// Layers are equal when they mean the same. `line` records where one was written and `id`
+/// which one it is, not what it means, so both are left out: that is what lets
+/// `parse(to_toml(look)) == look` hold.
 impl PartialEq for Layer {
     fn eq(&self, other: &Layer) -> bool {
         self.preset == other.preset
@@ -779,6 +804,7 @@ fn layer(src: &Source, raw: &Field<LayerFile>, library: &Library) -> crate::Resu
         opacity: src.read("opacity", &fields.opacity, unit_interval)?.unwrap_or(1.0),
         enabled: src.read("enabled", &fields.enabled, input::boolean)?.unwrap_or(true),
         line: src.line(raw.span().start),
+        id: LayerId::new(),
     })
 }
 

@@ -347,7 +347,8 @@ impl Running {
         }
         // Under a noise threshold, a wait for samples ends once every pixel has stopped.
         let samples = if self.session.converged() { u32::MAX } else { self.session.samples() };
-        let Some((line, step)) = runner.next(samples, self.session.target())? else {
+        let capped = self.session.target_override().is_some();
+        let Some((line, step)) = runner.next(samples, self.session.target(), capped)? else {
             return Ok(());
         };
         let action = match step {
@@ -459,10 +460,7 @@ impl Running {
             Action::Pick { x, y } => {
                 let pixel = self.session.inspect(x, y)?;
                 if pixel.coverage > 0.0 {
-                    let object = ObjectRef::Id(pixel.object_id);
-                    let document = &mut self.session.document;
-                    let top = document.stack(object).map(|s| s.layers.len().saturating_sub(1));
-                    document.select(Selection { object: Some(object), layer: top });
+                    self.session.document.select_object(ObjectRef::Id(pixel.object_id));
                 }
             }
             Action::ShowInspection => {

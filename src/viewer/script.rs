@@ -122,15 +122,22 @@ impl ScriptRunner {
     }
 
     /// The next step and its line; `None` when the script is done or waiting for samples. A
-    /// wait for more samples than the target would never end, so it is an error.
-    pub fn next(&mut self, samples: u32, target: u32) -> Result<Option<(usize, Step)>> {
+    /// wait for more samples than the target would never end, so it is an error, which names
+    /// what sets the target: `--exit-after-spp` (`capped`), else the look's or `spp`'s.
+    pub fn next(&mut self, samples: u32, target: u32, capped: bool) -> Result<Option<(usize, Step)>> {
         let Some((line, step)) = self.script.steps.get(self.next).cloned() else {
             return Ok(None);
         };
         if let Step::WaitSpp(spp) = step {
             if spp > target {
-                let problem =
-                    format!("wait-spp {spp} would never end: the target is {target} spp (raise it with `spp {spp}`)");
+                let problem = if capped {
+                    format!(
+                        "wait-spp {spp} would never end: --exit-after-spp {target} stops the viewer at {target} spp \
+                         (raise it to at least {spp})"
+                    )
+                } else {
+                    format!("wait-spp {spp} would never end: the target is {target} spp (raise it with `spp {spp}`)")
+                };
                 return Err(self.error_at(line, Error::input(problem)));
             }
             if samples < spp {

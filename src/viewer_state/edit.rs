@@ -251,7 +251,8 @@ impl State {
                 Ok(())
             })?,
             Edit::DuplicateLayer { object, layer } => next.edit_stack(object, |stack| {
-                let copy = layer_mut(stack, object, layer)?.clone();
+                let copy =
+                    Layer { id: crate::material::look::LayerId::new(), ..layer_mut(stack, object, layer)?.clone() };
                 stack.layers.insert(layer + 1, copy);
                 Ok(())
             })?,

@@ -37,7 +37,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use crate::material::library::Library;
-use crate::material::look::{Layer, Look, ObjectStack};
+use crate::material::look::{Layer, LayerId, Look, ObjectStack};
 use crate::material::params::{Param, Params, Value};
 use crate::render::settings::Settings;
 
@@ -66,6 +66,9 @@ pub struct Document {
     /// The content as last loaded or saved, for [`Document::is_dirty`].
     saved: State,
     selection: Selection,
+    /// The selected layer itself, which the selection follows through edits, undo and redo
+    /// wherever they move it in its stack.
+    selected_layer: Option<LayerId>,
     revision: u64,
     material_revision: u64,
     /// Preset parameters by the reference layers give, read once per document so that every
@@ -89,6 +92,7 @@ impl Document {
             path: look_path,
             history: History::new(),
             selection: Selection::default(),
+            selected_layer: None,
             revision: 0,
             material_revision: 0,
             presets: Mutex::new(BTreeMap::new()),
@@ -143,7 +147,18 @@ impl Document {
     /// Selects a stack and a layer; a layer index beyond the stack is brought within it.
     pub fn select(&mut self, selection: Selection) {
         self.selection = selection;
+        self.selected_layer = None;
         self.keep_selection_valid();
+    }
+
+    /// Selects `object`, as a click on it does: its top layer, unless the object is selected
+    /// already, when the layer stays as it is (so that the next edit lands where it did).
+    pub fn select_object(&mut self, object: ObjectRef) {
+        if self.selection.object == Some(object) {
+            return;
+        }
+        let top = self.stack(object).map(|s| s.layers.len().saturating_sub(1));
+        self.select(Selection { object: Some(object), layer: top });
     }
 
     /// Checks and applies an edit as an undo step of its own. The error is one line, and then
@@ -166,6 +181,16 @@ impl Document {
 
     fn apply_with(&mut self, edit: Edit, merging: bool) -> Result<(), String> {
         let key = edit.merge_key().filter(|_| merging);
+        // A duplicate of the selected layer takes the selection, as in a painting application:
+        // the next edit is the copy's.
+        let duplicated = match &edit {
+            Edit::DuplicateLayer { object, layer }
+                if self.selection.object == Some(*object) && self.selection.layer == Some(*layer) =>
+            {
+                Some((*object, *layer + 1))
+            }
+            _ => None,
+        };
         let next = self.state.applied(edit, &|reference| self.preset_params(reference), &self.saved.look)?;
         if next == self.state {
             return Ok(());
@@ -173,6 +198,9 @@ impl Document {
         let before = std::mem::replace(&mut self.state, next);
         self.note_change(&before.look.objects);
         self.history.record(before, &self.state, key);
+        if let Some((object, copy)) = duplicated {
+            self.select(Selection { object: Some(object), layer: Some(copy) });
+        }
         Ok(())
     }
 
@@ -265,12 +293,21 @@ impl Document {
         self.keep_selection_valid();
     }
 
+    /// Keeps the selection on its layer wherever that now is in the stack; where the layer is
+    /// gone, on the index, brought within the stack.
     fn keep_selection_valid(&mut self) {
-        let count = self.selection.object.and_then(|o| self.stack(o)).map_or(0, |s| s.layers.len());
-        self.selection.layer = match self.selection.layer {
-            Some(_) if count == 0 => None,
-            Some(layer) => Some(layer.min(count - 1)),
-            None => None,
+        let ids: Vec<LayerId> = self
+            .selection
+            .object
+            .and_then(|o| self.stack(o))
+            .map_or_else(Vec::new, |s| s.layers.iter().map(|l| l.id).collect());
+        let followed = self.selected_layer.and_then(|id| ids.iter().position(|&l| l == id));
+        self.selection.layer = match (followed, self.selection.layer) {
+            (Some(index), Some(_)) => Some(index),
+            (_, Some(_)) if ids.is_empty() => None,
+            (_, Some(layer)) => Some(layer.min(ids.len() - 1)),
+            (_, None) => None,
         };
+        self.selected_layer = self.selection.layer.and_then(|i| ids.get(i).copied());
     }
 }
