@@ -9,6 +9,11 @@ use egui::{pos2, vec2, Color32, PointerButton, Rect, Sense};
 
 /// Degrees of environment rotation per point dragged: a drag across a typical view is a turn.
 const DEGREES_PER_POINT: f32 = 0.4;
+/// The band along the view's bottom edge that holds the hint line and the pixel readout; what
+/// else is drawn in the view (the false-colour legend) stays above it.
+pub const FOOTER: f32 = 24.0;
+/// The gap kept between the hint line and the pixel readout.
+const FOOTER_GAP: f32 = 16.0;
 pub const MIN_SCALE: f32 = 1.0 / 16.0;
 pub const MAX_SCALE: f32 = 32.0;
 
@@ -260,18 +265,30 @@ impl Viewport {
         if let Some(pixel) = response.hover_pos().and_then(|p| pixel_at(p, image_rect, w, h)) {
             corner = format!("{}, {}   {corner}", pixel.0, pixel.1);
         }
-        painter.text(rect.right_bottom() - vec2(10.0, 8.0), egui::Align2::RIGHT_BOTTOM, corner, font.clone(), color);
+        let corner = painter.layout_no_wrap(corner, font.clone(), color);
+        let corner_width = corner.size().x;
+        painter.galley(rect.right_bottom() - vec2(10.0 + corner_width, 8.0 + corner.size().y), corner, color);
         if response.hovered() && !ui.input(|i| i.pointer.any_down()) {
-            painter.text(
-                rect.left_bottom() + vec2(10.0, -8.0),
-                egui::Align2::LEFT_BOTTOM,
-                "click: inspect · Shift+drag: rotate light · drag: pan · wheel: zoom · F: fit · 1: 1:1 · ?: hotkeys",
-                font,
-                Color32::from_gray(130),
-            );
+            // The longest hint that leaves the readout room: never text over text.
+            let room = rect.width() - 20.0 - corner_width - FOOTER_GAP;
+            let hint = HINTS
+                .iter()
+                .map(|hint| painter.layout_no_wrap(hint.to_string(), font.clone(), Color32::from_gray(130)))
+                .find(|galley| galley.size().x <= room);
+            if let Some(hint) = hint {
+                painter.galley(rect.left_bottom() + vec2(10.0, -8.0 - hint.size().y), hint, Color32::from_gray(130));
+            }
         }
     }
 }
+
+/// The hint line under the image, longest first: the first that fits beside the pixel readout is
+/// shown.
+const HINTS: [&str; 3] = [
+    "click: inspect · Shift+drag: rotate light · drag: pan · wheel: zoom · F: fit · 1: 1:1 · ?: hotkeys",
+    "click: inspect · Shift+drag: rotate light · ?: hotkeys",
+    "?: hotkeys",
+];
 
 /// The divider line and the halves' labels, "A: …" top left and "B: …" top right, each on a dark
 /// plate so that it reads over any image.

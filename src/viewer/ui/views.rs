@@ -123,7 +123,7 @@ fn legend(painter: &egui::Painter, view: Rect, image: Rect) {
     let swatches = swatch.x * FALSE_COLOURS.len() as f32;
     let width = swatches + 6.0 + caption.size().x;
     let height = swatch.y + 14.0;
-    let top = if image.max.y + 4.0 + height <= view.max.y { image.max.y + 4.0 } else { image.max.y - height - 2.0 };
+    let top = legend_top(view, image, height);
     // Centred under the image, kept inside the view.
     let left = (image.center().x - width / 2.0).min(view.max.x - width - 4.0).max(view.min.x + 4.0);
     painter.rect_filled(
@@ -144,6 +144,15 @@ fn legend(painter: &egui::Painter, view: Rect, image: Rect) {
     }
     let at = pos2(left + swatches + 6.0, top + (swatch.y - caption.size().y) / 2.0);
     painter.galley(at, caption, Color32::from_gray(180));
+}
+
+/// Where the legend's top goes: under the image where there is room above the view's footer
+/// (the hint line and the pixel readout), else over the image's bottom edge, and never in the
+/// footer.
+fn legend_top(view: Rect, image: Rect, height: f32) -> f32 {
+    let floor = view.max.y - super::viewport::FOOTER;
+    let top = if image.max.y + 4.0 + height <= floor { image.max.y + 4.0 } else { image.max.y - height - 2.0 };
+    top.min(floor - height - 2.0)
 }
 
 /// The histogram of the current view's luminance: stops about 18% grey for radiance views,
@@ -192,4 +201,25 @@ pub fn histogram(ui: &mut egui::Ui, state: &Views) {
         ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| ui.small(right));
     });
     ui.small(format!("{} · {} pixels", unit, histogram.counted));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The legend never reaches into the footer, where the hint line is drawn: with the image
+    /// filling the view to its bottom edge, it once sat on the hint, text on text.
+    #[test]
+    fn the_legend_stays_out_of_the_footer() {
+        let view = Rect::from_min_max(pos2(0.0, 0.0), pos2(800.0, 600.0));
+        let floor = view.max.y - super::super::viewport::FOOTER;
+        for image_bottom in [300.0, 540.0, 560.0, 590.0, 600.0, 700.0] {
+            let image = Rect::from_min_max(pos2(100.0, 0.0), pos2(700.0, image_bottom));
+            let top = legend_top(view, image, 30.0);
+            assert!(top + 30.0 <= floor, "image to {image_bottom}: the legend reaches {} past {floor}", top + 30.0);
+            if image_bottom + 4.0 + 30.0 <= floor {
+                assert_eq!(top, image_bottom + 4.0, "under the image where there is room");
+            }
+        }
+    }
 }
