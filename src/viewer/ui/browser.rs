@@ -26,6 +26,8 @@ struct Entry {
 #[derive(Default)]
 pub struct Browser {
     pub open: bool,
+    /// Whether the search field has had the focus since the library opened.
+    focused: bool,
     search: String,
     tag: Option<String>,
     /// Read when the browser opens, and again after a preset is saved.
@@ -76,6 +78,7 @@ impl Browser {
                 .collect()
         });
         let mut open = self.open;
+        super::close_on_escape(ctx, &mut open);
         let mut refresh = false;
         let target = session.document.selection().object.map_or("the default stack".to_string(), |o| o.to_string());
         let window = egui::Window::new("Preset library")
@@ -85,7 +88,13 @@ impl Browser {
             .resizable(true);
         window.show(ctx, |ui| {
             ui.horizontal(|ui| {
-                ui.add(egui::TextEdit::singleline(&mut self.search).hint_text("search names, tags, descriptions"));
+                let search =
+                    ui.add(egui::TextEdit::singleline(&mut self.search).hint_text("search names, tags, descriptions"));
+                // Typing starts a search as soon as the library opens.
+                if !self.focused {
+                    search.request_focus();
+                    self.focused = true;
+                }
                 let tags: BTreeSet<&String> = entries.iter().flat_map(|e| &e.tags).collect();
                 egui::ComboBox::from_id_salt("tag filter")
                     .selected_text(self.tag.clone().unwrap_or_else(|| "all tags".into()))
@@ -138,6 +147,8 @@ impl Browser {
             }
         });
         self.open = open;
+        // Opened again, the search field takes the focus again.
+        self.focused &= open;
         if refresh {
             self.refresh();
         }

@@ -48,6 +48,7 @@ impl Browser {
         let listing = self.listing.get_or_insert_with(|| library.listing());
         let current = EnvironmentRef::or_default(session.document.settings().environment.as_ref());
         let mut open = self.open;
+        super::close_on_escape(ctx, &mut open);
         let mut refresh = false;
         egui::Window::new("Environments")
             .open(&mut open)

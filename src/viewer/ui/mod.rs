@@ -434,3 +434,42 @@ mod region_tests {
         assert_eq!(super::region_status((1_048_576, 1, 4)), "re-converging 1 048 576 px: 1/4 spp");
     }
 }
+
+/// Closes a window on Escape, as every dialog does: `open` becomes false when Escape was
+/// pressed this frame (by a person or a script's `key Escape`).
+pub fn close_on_escape(ctx: &egui::Context, open: &mut bool) {
+    if *open && ctx.input(|i| i.key_pressed(egui::Key::Escape)) {
+        *open = false;
+    }
+}
+
+#[cfg(test)]
+mod escape_tests {
+    use super::close_on_escape;
+
+    fn frame_with(ctx: &egui::Context, events: Vec<egui::Event>, open: &mut bool) {
+        let input = egui::RawInput { events, ..Default::default() };
+        let _ = ctx.run_ui(input, |ui| close_on_escape(ui.ctx(), open));
+    }
+
+    /// The preset library and the environments window close on Escape, and only on it: they
+    /// once stayed open, by a real key and by a script's.
+    #[test]
+    fn escape_closes_a_window_and_other_keys_do_not() {
+        let ctx = egui::Context::default();
+        let key = |key: egui::Key| egui::Event::Key {
+            key,
+            physical_key: None,
+            pressed: true,
+            repeat: false,
+            modifiers: egui::Modifiers::NONE,
+        };
+        let mut open = true;
+        frame_with(&ctx, vec![key(egui::Key::A)], &mut open);
+        assert!(open, "another key leaves it open");
+        frame_with(&ctx, Vec::new(), &mut open);
+        assert!(open);
+        frame_with(&ctx, vec![key(egui::Key::Escape)], &mut open);
+        assert!(!open, "Escape closes it");
+    }
+}
