@@ -29,6 +29,7 @@ pub const HOTKEYS: &[Hotkey] = &[
     Hotkey { keys: "O", does: "Shadows (the g-buffer's visibility) on or off, for comparison" },
     Hotkey { keys: "?", does: "Show or hide this sheet" },
     Hotkey { keys: "Enter", does: "In a file dialog's name field: open or save that file" },
+    Hotkey { keys: "Escape", does: "Close the preset library or the environments window" },
 ];
 
 /// The mouse in the image and the panels.
