@@ -273,13 +273,9 @@ impl Distribution {
         [self.width, self.height, self.block_x, self.block_y, self.columns, self.rows, 0, 0]
     }
 
-    /// Writes the texels as the GPU stores them, row-major: each one's radiance from `env`, and
-    /// its cell's pdf_ω in a, so that one fetch gives both.
-    pub fn write_texels(&self, env: &Environment, out: &mut [[f32; 4]]) {
-        self.write_texel_rows(env, 0, out);
-    }
-
-    /// [`Distribution::write_texels`] for the rows from `first_row` on, as many as `out` holds.
+    /// Writes the texels as the GPU stores them, row-major, for the rows from `first_row` on, as
+    /// many as `out` holds: each one's radiance from `env`, and its cell's pdf_ω in a, so that
+    /// one fetch gives both.
     pub fn write_texel_rows(&self, env: &Environment, first_row: u32, out: &mut [[f32; 4]]) {
         let width = self.width as usize;
         let texels = &env.texels[first_row as usize * width..];
