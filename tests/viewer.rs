@@ -37,6 +37,28 @@ fn the_viewer_opens_renders_and_its_screenshot_matches_lookdev_render() {
     assert!(mean_level > 20.0, "the image is nearly black: {mean_level}");
 }
 
+/// Left alone, with no script and no input events at all, the viewer relights until the target
+/// and draws the window only as the image changes: a few frames, most of the relighting in
+/// slices between them. The interactive budget is 1 ms, so that the frames alone would take
+/// hundreds to get there.
+#[test]
+fn left_alone_the_viewer_reaches_its_target_drawing_only_as_the_image_changes() {
+    let Some(case) = Case::new() else { return };
+    let output = case
+        .view_with_env(&["look.toml", "--seed", "7", "--exit-after-spp", "48"], &[("LOOKDEV_FRAME_BUDGET_MS", "1")]);
+    assert_success(&output);
+    let report = stderr(&output);
+    assert!(report.contains(": 48 spp;"), "{report}");
+    let count = |after: &str| -> u64 {
+        let at = report.find(after).unwrap_or_else(|| panic!("no '{after}' in {report}"));
+        let digits: String = report[..at].chars().rev().skip(1).take_while(char::is_ascii_digit).collect();
+        digits.chars().rev().collect::<String>().parse().unwrap()
+    };
+    let (frames, slices) = (count("frames drawn"), count("relighting slices"));
+    assert!(slices >= 1, "{report}");
+    assert!(frames <= 16, "{frames} frames drawn for 48 spp: {report}");
+}
+
 /// `view --set` reaches every object, as `render --set` does, also on a look with no default
 /// stack: the pedestal (object 2), which has no stack of its own, takes the red too.
 #[test]

@@ -53,7 +53,11 @@ pub fn accumulate(renderer: &mut Renderer, spp: u32, mut progress: impl FnMut(u3
         batch = batch.min(noise.min_samples.max(1));
     }
     while renderer.samples() < spp && renderer.active_pixels() != Some(0) {
-        let count = batch.min(spp - renderer.samples());
+        let samples = renderer.samples();
+        // Under a noise threshold a dispatch ends at the next stop test: a pixel that stops
+        // there would otherwise idle in its SIMD group while the others go on.
+        let count = renderer.noise_threshold().map_or(spp, |n| samples + n.to_checkpoint(samples)).min(spp) - samples;
+        let count = batch.min(count);
         let pixels = renderer.pixels_to_relight();
         let dispatch_start = Instant::now();
         let gpu = renderer.render_samples(count)?;

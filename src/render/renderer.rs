@@ -719,6 +719,22 @@ impl Renderer {
         crate::gpu::context::full_barrier(&self.ctx.shared.device, cmd);
     }
 
+    /// Makes the display pixels (and linear radiance) of every row relit since it was last
+    /// finalized, with `exposure` and `tonemap`, in one submission: what the viewer does before
+    /// it draws, however many bands were relit since.
+    pub fn finalize_stale(&self, exposure: f32, tonemap: Tonemap) -> Result<()> {
+        let stale = runs_of_false(&self.finalized_rows.borrow());
+        if stale.is_empty() {
+            return Ok(());
+        }
+        self.ctx.run(|cmd| {
+            for &(first, rows) in &stale {
+                self.record_finalize(cmd, first, rows, exposure, tonemap);
+            }
+            Ok(())
+        })
+    }
+
     /// Makes the display pixels (and linear radiance) of rows `first_row..first_row + rows` from
     /// their current sums, for the viewer to show.
     pub fn finalize_rows(&self, first_row: u32, rows: u32, exposure: f32, tonemap: Tonemap) -> Result<()> {

@@ -40,6 +40,17 @@ impl NoiseThreshold {
         }
         Ok(NoiseThreshold { threshold, min_samples })
     }
+
+    /// Samples from `samples` to the next stop test (`checkpoint` in relight.comp): at
+    /// `min_samples`, then at each power of two above it. A dispatch that ends there lets no
+    /// pixel go on sampling past a test it would pass while the others in its SIMD group finish.
+    pub fn to_checkpoint(&self, samples: u32) -> u32 {
+        if samples < self.min_samples {
+            self.min_samples - samples
+        } else {
+            (samples + 1).next_power_of_two() - samples
+        }
+    }
 }
 
 /// Values given on the command line; `None` leaves the look's value.
@@ -159,5 +170,19 @@ fn noise_threshold(look: &Look, overrides: &Overrides, spp: u32) -> Result<Optio
         (Some(threshold), Some((min_spp, _))) => NoiseThreshold::new(threshold, min_spp).map(Some),
         // With fewer samples than that in all, the pixels take them all.
         (Some(threshold), None) => NoiseThreshold::new(threshold, DEFAULT_MIN_SPP.min(spp).max(2)).map(Some),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn checkpoints_are_the_minimum_then_each_power_of_two_above_it() {
+        let noise = NoiseThreshold::new(0.05, 6).unwrap();
+        let next: Vec<u32> = [0, 5, 6, 7, 8, 9, 31, 32].iter().map(|&s| s + noise.to_checkpoint(s)).collect();
+        assert_eq!(next, [6, 6, 8, 8, 16, 16, 32, 64]);
+        let four = NoiseThreshold::new(0.05, 4).unwrap();
+        assert_eq!([0, 4, 5].map(|s| s + four.to_checkpoint(s)), [4, 8, 8]);
     }
 }

@@ -1,12 +1,16 @@
-//! The window and its frames. A frame takes one script step, runs the interface, carries out
-//! the actions it produced, hands the renderer what changed, relights one band, and presents.
-//! Carrying out the actions before relighting means an edit's first band is in the very frame
-//! that made it.
+//! The window and its frames. After each turn of the event loop the frame scheduler
+//! ([`super::schedule`]) says what comes next: a frame, a slice of relighting with no frame, or
+//! a wait. A frame takes one script step, runs the interface, carries out the actions it
+//! produced, hands the renderer what changed, relights one band, and presents. Carrying out the
+//! actions before relighting means an edit's first band is in the very frame that made it.
+//! Everything happens when the event loop is about to wait, so that nothing depends on the
+//! window system's redraw events, which only ask for a frame.
 
 use super::action::{Action, Answer, Compare};
 use super::environments::EnvironmentLibrary;
 use super::gui::Gui;
 use super::presenter::Presenter;
+use super::schedule::{FrameScheduler, Next, Situation};
 use super::script::{ScriptRunner, Step};
 use super::session::Session;
 use super::thumbnails::{self, Thumbnails};
@@ -118,8 +122,14 @@ impl ApplicationHandler for App {
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
-        if let Some(running) = &mut self.running {
-            event_loop.set_control_flow(running.schedule());
+        let Some(running) = &mut self.running else { return };
+        match running.turn() {
+            Ok(flow) if !running.quit => event_loop.set_control_flow(flow),
+            Ok(_) => event_loop.exit(),
+            Err(e) => {
+                self.outcome = Err(e);
+                event_loop.exit();
+            }
         }
     }
 }
@@ -152,6 +162,9 @@ struct Running {
     exit_after_spp: Option<u32>,
     final_screenshot: Option<PathBuf>,
     clock: FrameClock,
+    scheduler: FrameScheduler,
+    /// Whether a window event asked for a frame since the last one.
+    frame_wanted: bool,
     title: String,
     next_repaint: Option<Instant>,
     quit: bool,
@@ -218,6 +231,8 @@ impl Running {
             exit_after_spp: options.exit_after_spp,
             final_screenshot: options.screenshot.clone(),
             clock: FrameClock::default(),
+            scheduler: FrameScheduler::new(super::progressive::frame_budget()),
+            frame_wanted: true,
             title: String::new(),
             next_repaint: None,
             quit: false,
@@ -228,7 +243,6 @@ impl Running {
             running.interface.tell(warning, true);
         }
         running.update_title();
-        running.window.request_redraw();
         Ok(running)
     }
 
@@ -236,41 +250,82 @@ impl Running {
     fn window_event(&mut self, event: WindowEvent) -> Result<bool> {
         match &event {
             WindowEvent::RedrawRequested => {
-                self.redraw()?;
+                self.frame_wanted = true;
                 return Ok(!self.quit);
             }
             WindowEvent::CloseRequested => self.queue.push((Origin::Interface, Action::Quit)),
-            WindowEvent::Resized(size) => self.presenter.resize(size.width, size.height),
+            WindowEvent::Resized(size) => {
+                self.presenter.resize(size.width, size.height);
+                self.frame_wanted = true;
+            }
             _ => {}
         }
-        self.gui.on_event(&self.window, &event);
-        self.window.request_redraw();
+        if self.gui.on_event(&self.window, &event) {
+            self.frame_wanted = true;
+            self.scheduler.input(Instant::now());
+        }
         Ok(true)
     }
 
-    /// How the event loop should wait: not at all while rendering or scripted, else until the
-    /// interface next wants a frame or an event comes.
-    fn schedule(&mut self) -> ControlFlow {
-        let busy = !self.session.converged()
-            || self.script.as_ref().is_some_and(|s| !s.finished())
-            || self.exit_after_spp.is_some()
-            || !self.queue.is_empty()
-            || !self.screenshots.is_empty();
-        match self.next_repaint {
-            _ if busy => {
-                self.window.request_redraw();
-                ControlFlow::Poll
+    /// One turn of the event loop, before it waits: a frame, a slice of relighting or nothing,
+    /// as the frame scheduler decides. Returns how the loop should wait.
+    fn turn(&mut self) -> Result<ControlFlow> {
+        let situation = self.situation();
+        match self.scheduler.next(&situation) {
+            Next::Draw { relight } => {
+                self.frame_wanted = false;
+                self.redraw(relight)?;
+                Ok(ControlFlow::Poll)
             }
-            Some(at) if at <= Instant::now() => {
-                self.window.request_redraw();
-                ControlFlow::Poll
+            Next::Relight(slice) => {
+                self.clock.slices += 1;
+                let end = Instant::now() + slice;
+                while let Some(left) = end.checked_duration_since(Instant::now()).filter(|d| !d.is_zero()) {
+                    if !self.session.step(left)? {
+                        break;
+                    }
+                }
+                Ok(ControlFlow::Poll)
             }
-            Some(at) => ControlFlow::WaitUntil(at),
-            None => ControlFlow::Wait,
+            Next::Wait(Some(at)) => Ok(ControlFlow::WaitUntil(at)),
+            Next::Wait(None) => Ok(ControlFlow::Wait),
         }
     }
 
-    fn redraw(&mut self) -> Result<()> {
+    /// What the frame scheduler needs to know now.
+    fn situation(&self) -> Situation {
+        let samples = self.session.samples();
+        let target = self.session.target();
+        let script_ready = self.script.as_ref().is_some_and(|runner| runner.ready(self.shown_samples(), target));
+        let exiting = self.exit_after_spp.is_some_and(|spp| {
+            self.script.as_ref().is_none_or(|s| s.finished()) && (samples >= spp || self.session.converged())
+        });
+        Situation {
+            now: Instant::now(),
+            rendering: !self.session.converged(),
+            samples,
+            target,
+            needs_frame: self.frame_wanted
+                || script_ready
+                || exiting
+                || !self.queue.is_empty()
+                || !self.screenshots.is_empty(),
+            repaint_at: self.next_repaint,
+        }
+    }
+
+    /// The samples a script's wait counts: under a noise threshold, a wait ends once every
+    /// pixel has stopped.
+    fn shown_samples(&self) -> u32 {
+        if self.session.converged() {
+            u32::MAX
+        } else {
+            self.session.samples()
+        }
+    }
+
+    /// Draws a frame, relighting for `relight` in it.
+    fn redraw(&mut self, relight: Duration) -> Result<()> {
         let started = Instant::now();
         let finishing = self.headless_done();
         // Before the frame's actions too, so that the first one finds the look's snapshots.
@@ -313,9 +368,10 @@ impl Running {
             self.session.sync()?;
             self.interface.tell(format!("{e}; the change was undone"), true);
         }
-        if !finishing {
-            self.session.step()?;
+        if !finishing && !relight.is_zero() {
+            self.session.step(relight)?;
         }
+        self.session.prepare_display()?;
         self.session.refresh_delta_e()?;
         self.update_title();
         let capture = finishing || !self.screenshots.is_empty();
@@ -323,7 +379,8 @@ impl Running {
         if capture {
             self.save_screenshots(captured, finishing)?;
         }
-        self.clock.record(started.elapsed(), !self.session.converged());
+        self.clock.record(started.elapsed(), !self.session.converged(), self.session.samples());
+        self.scheduler.drawn(Instant::now(), self.session.samples(), started.elapsed());
         Ok(())
     }
 
@@ -339,14 +396,13 @@ impl Running {
 
     /// Queues the script's next action, unless it is waiting for samples.
     fn script_step(&mut self) -> Result<()> {
+        let samples = self.shown_samples();
         let Some(runner) = &mut self.script else { return Ok(()) };
         // A key pressed last frame acts in this one's interface: its question, if it raises
         // one, comes before the script's next line, which may answer it.
         if self.scripted_key.is_some_and(|(_, frame)| self.clock.frames <= frame + 1) {
             return Ok(());
         }
-        // Under a noise threshold, a wait for samples ends once every pixel has stopped.
-        let samples = if self.session.converged() { u32::MAX } else { self.session.samples() };
         let capped = self.session.target_override().is_some();
         let Some((line, step)) = runner.next(samples, self.session.target(), capped)? else {
             return Ok(());
@@ -368,6 +424,9 @@ impl Running {
     fn perform(&mut self, origin: Origin, action: Action) -> Result<()> {
         let scripted_pick =
             matches!((origin, &action), (Origin::Script(_), Action::Pick { .. } | Action::ShowInspection));
+        if let Origin::Script(_) = origin {
+            self.scheduler.input(Instant::now());
+        }
         if let (Origin::Script(line), Action::Key(..)) = (origin, &action) {
             self.scripted_key = Some((line, self.clock.frames));
         }
@@ -755,12 +814,14 @@ impl Running {
             format!("{:.0} ms ({block}x{block} blocks)", d.as_secs_f64() * 1e3)
         });
         format!(
-            "viewer: {}x{} on {}: {} spp; frame time while rendering {}; preview after the last change {preview}; first full pass after it {first}; {:.1} M samples/s",
+            "viewer: {}x{} on {}: {} spp; frame time while rendering {}; {} frames drawn, {} relighting slices between them; preview after the last change {preview}; first full pass after it {first}; {:.1} M samples/s",
             session.width(),
             session.height(),
             session.device_name(),
             session.samples(),
             self.clock.rendering_summary(),
+            self.clock.frames,
+            self.clock.slices,
             session.progressive.samples_per_second_with(session.compare_progressive()) / 1e6
         )
     }
@@ -797,19 +858,22 @@ fn selected_layer(document: &Document) -> Result<(ObjectRef, usize)> {
     }
 }
 
-/// Frame times: a recent mean for the status bar, and every frame spent rendering for the report.
+/// Frame times: a recent mean for the status bar, and every frame spent rendering for the
+/// report, which also counts the relighting slices run without a frame.
 #[derive(Default)]
 struct FrameClock {
     frames: u64,
+    slices: u64,
     recent: Vec<Duration>,
-    rendering: Vec<Duration>,
+    /// Each frame drawn while rendering: its time and the samples it showed.
+    rendering: Vec<(Duration, u32)>,
 }
 
 impl FrameClock {
     /// Frames in the recent mean.
     const RECENT: usize = 30;
 
-    fn record(&mut self, time: Duration, rendering: bool) {
+    fn record(&mut self, time: Duration, rendering: bool, samples: u32) {
         self.frames += 1;
         if self.recent.len() == Self::RECENT {
             self.recent.remove(0);
@@ -817,7 +881,7 @@ impl FrameClock {
         self.recent.push(time);
         // The first frames build pipelines and fonts; they are not what an artist waits for.
         if rendering && self.frames > 3 {
-            self.rendering.push(time);
+            self.rendering.push((time, samples));
         }
     }
 
@@ -829,14 +893,24 @@ impl FrameClock {
         }
     }
 
-    /// "median 31 ms, 95th percentile 40 ms over 120 frames".
+    /// "median 31 ms, 95th percentile 40 ms, longest 52 ms over 120 frames, showing 4 spp
+    /// (median)"; 0 spp is a preview, or a first pass not yet done.
     fn rendering_summary(&self) -> String {
         if self.rendering.is_empty() {
             return "n/a".into();
         }
-        let mut times: Vec<f64> = self.rendering.iter().map(|d| d.as_secs_f64() * 1e3).collect();
+        let mut times: Vec<f64> = self.rendering.iter().map(|(d, _)| d.as_secs_f64() * 1e3).collect();
         times.sort_by(f64::total_cmp);
         let at = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize];
-        format!("median {:.1} ms, 95th percentile {:.1} ms over {} frames", at(0.5), at(0.95), times.len())
+        let mut shown: Vec<u32> = self.rendering.iter().map(|&(_, samples)| samples).collect();
+        shown.sort_unstable();
+        format!(
+            "median {:.1} ms, 95th percentile {:.1} ms, longest {:.1} ms over {} frames, showing {} spp (median)",
+            at(0.5),
+            at(0.95),
+            at(1.0),
+            times.len(),
+            shown[shown.len() / 2]
+        )
     }
 }

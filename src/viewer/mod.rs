@@ -6,6 +6,7 @@
 //! - [`ui`] draws the panels and turns every click and drag into an [`Action`].
 //! - [`script`] reads the same actions from a file, for tests and automation.
 //! - [`app`] owns the window and runs a frame: script step, relight band, interface, present.
+//! - [`schedule`] decides what each turn of the event loop does: draw, relight or wait.
 //! - [`presenter`], [`gui`] and [`progressive`] are the plumbing under it.
 //! - [`views`] and [`view_image`]: the views shown instead of the beauty (AOVs, false colour),
 //!   and the current one's CPU copy for the histogram, clipping overlay and values under the
@@ -19,6 +20,7 @@ mod environments;
 mod gui;
 mod presenter;
 mod progressive;
+mod schedule;
 mod script;
 mod session;
 mod snapshots;

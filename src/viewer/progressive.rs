@@ -1,9 +1,12 @@
-//! Progressive rendering bounded per frame: each frame relights a band of rows, sized from the
-//! measured speed so the frame stays responsive; a pass is done when the bands have swept the
-//! image. On a fast device a band is the whole image, so a change shows within one frame.
+//! Progressive rendering bounded by a time budget: each step relights a band of rows, sized from
+//! the measured speed so that it fits the budget it is given; a pass is done when the bands have
+//! swept the image. The frame scheduler ([`super::schedule`]) gives a short budget while the
+//! artist interacts, so that frames stay responsive, and long ones while nobody does, so that
+//! the image converges as fast as `lookdev render` makes it: a band is then the whole image, and
+//! it takes as many samples as fit.
 //!
-//! The first frame after a change is a preview: one sample per 2×2, 4×4 (or, on a very slow
-//! device, 8×8) block, the smallest block that fits the frame's budget, interpolated to every
+//! The first step after a change is a preview: one sample per 2×2, 4×4 (or, on a very slow
+//! device, 8×8) block, the smallest block that fits the interactive budget, interpolated to every
 //! pixel. So the whole image shows the new state at once, and the passes replace the preview
 //! band by band: no row ever shows the state before the change.
 //!
@@ -11,14 +14,17 @@
 //! bands relight those pixels alone, the first sweep one sample each, the next up to
 //! [`CATCH_UP_SAMPLES`], until they have caught up with the rest
 //! (docs/commands.md#edit-local-re-convergence).
+//!
+//! Steps only relight; the display pixels of the rows they changed are made once, before the
+//! window is drawn ([`Renderer::finalize_stale`]).
 
 use crate::render::Renderer;
-use crate::shading::tonemap::Tonemap;
 use crate::Result;
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-/// Relighting time allowed per frame, shared by the renderers on screen (two in an A/B split).
+/// Relighting time allowed per frame while the artist interacts, shared by the renderers on
+/// screen (two in an A/B split).
 pub const FRAME_BUDGET: Duration = Duration::from_millis(25);
 /// `LOOKDEV_FRAME_BUDGET_MS`: another budget, in milliseconds, so that a test can make any
 /// device sweep a pass over many frames, as a slow one does.
@@ -40,7 +46,8 @@ pub fn configure_budget() -> Result<()> {
     Ok(())
 }
 
-/// The relighting time per frame: [`FRAME_BUDGET`] unless [`configure_budget`] read another.
+/// The relighting time per interactive frame: [`FRAME_BUDGET`] unless [`configure_budget`]
+/// read another.
 pub fn frame_budget() -> Duration {
     BUDGET.get().copied().unwrap_or(FRAME_BUDGET)
 }
@@ -67,8 +74,6 @@ const PREVIEW_BACKGROUND_SHARE: f64 = 0.1;
 
 /// Where the sweep is, how fast rows relight, and the figures the status bar shows.
 pub struct Progressive {
-    /// This renderer's share of [`frame_budget`].
-    budget: Duration,
     cursor: u32,
     /// Seconds to relight one row with one sample (a running average).
     row_seconds: f64,
@@ -95,7 +100,6 @@ pub struct Progressive {
 impl Progressive {
     pub fn new() -> Progressive {
         Progressive {
-            budget: frame_budget(),
             cursor: 0,
             row_seconds: 0.0,
             started: Instant::now(),
@@ -107,11 +111,6 @@ impl Progressive {
             region_swept: false,
             region_cursor: 0,
         }
-    }
-
-    /// Sets this renderer's share of the frame's relighting time.
-    pub fn set_budget(&mut self, budget: Duration) {
-        self.budget = budget;
     }
 
     /// Starts over after an edit: the renderer has restarted its accumulation.
@@ -135,54 +134,57 @@ impl Progressive {
     /// The preview's block: the smallest whose one sample per block is expected to fit the
     /// budget at the measured speed, or 4 before anything is measured. Blocks of b × b relight
     /// a b²-th of the pixels; every pixel's background costs about a tenth of a sample.
-    fn preview_block(&self, height: u32) -> u32 {
+    fn preview_block(&self, height: u32, budget: Duration) -> u32 {
         if self.row_seconds <= 0.0 {
             return 4;
         }
         let fits = |block: u32| {
             let rows = height as f64 / (block * block) as f64 + height as f64 * PREVIEW_BACKGROUND_SHARE;
-            rows * self.row_seconds <= self.budget.as_secs_f64()
+            rows * self.row_seconds <= budget.as_secs_f64()
         };
         [2, 4].into_iter().find(|&b| fits(b)).unwrap_or(crate::render::renderer::MAX_PREVIEW_BLOCK)
     }
 
-    /// Relights the next band if the image has fewer than `target` samples, then makes its
-    /// display pixels. The first frame after a change is the preview instead; the first pass
-    /// takes one sample per band, so the preview is replaced soonest; later bands take a few.
-    /// Returns whether anything was rendered.
-    pub fn step(&mut self, renderer: &mut Renderer, target: u32, exposure: f32, tonemap: Tonemap) -> Result<bool> {
+    /// Relights the next band if the image has fewer than `target` samples, within about
+    /// `budget`. The first step after a change is the preview instead (sized to the interactive
+    /// budget, however long this one is: it is what an edit shows first); the first pass takes
+    /// one sample per band, so the preview is replaced soonest; later bands take a few, or,
+    /// where the budget covers the rest of the pass, as many as fit. Returns whether anything
+    /// was rendered.
+    pub fn step(&mut self, renderer: &mut Renderer, target: u32, budget: Duration) -> Result<bool> {
         // Under a noise threshold, accumulation also stops once every pixel has stopped.
         if renderer.samples() >= target || renderer.active_pixels() == Some(0) {
             return Ok(false);
         }
         if let Some((_, theirs, _)) = renderer.restarted_region() {
-            return self.step_region(renderer, theirs, target, exposure, tonemap);
+            return self.step_region(renderer, theirs, target, budget);
         }
         let height = renderer.height;
         if renderer.preview_block().is_none() && (0..height).all(|row| renderer.row_samples(row) == 0) {
-            let block = self.preview_block(height);
+            let block = self.preview_block(height, budget.min(frame_budget()));
             renderer.render_preview(block)?;
-            renderer.finalize_rows(0, height, exposure, tonemap)?;
             self.preview = Some((self.started.elapsed(), block));
             return Ok(true);
         }
-        if renderer.row_samples(self.cursor) >= target {
-            // The rows from here on are done (a completed pass caught them up): start over.
-            self.cursor = 0;
+        // Bands may take different counts, so rows differ by more than a band: the sweep goes
+        // on at the first row short of the target, over the rows short of it from there, and
+        // takes no more samples than the most-sampled of them lacks, so that no row passes it.
+        let short = |row: u32| renderer.row_samples(row) < target;
+        if !short(self.cursor) {
+            match (0..height).find(|&row| short(row)) {
+                Some(row) => self.cursor = row,
+                None => return Ok(false),
+            }
         }
-        let count = match self.first_pass {
-            None => 1,
-            Some(_) => SAMPLES_PER_BAND.min(target - renderer.row_samples(self.cursor)),
-        };
-        let wanted = if self.row_seconds > 0.0 {
-            (self.budget.as_secs_f64() / (self.row_seconds * count as f64)) as u32
-        } else {
-            MIN_BAND_ROWS // the first band measures the device
-        };
-        let rows = wanted.max(MIN_BAND_ROWS).min(height - self.cursor);
+        let run_end = (self.cursor..height).find(|&row| !short(row)).unwrap_or(height);
+        let most = (self.cursor..run_end).map(|row| renderer.row_samples(row)).max().unwrap_or(0);
+        // Under a noise threshold a band ends at the next stop test, so that pixels stopping
+        // there cost nothing after it.
+        let lacking = renderer.noise_threshold().map_or(target - most, |n| n.to_checkpoint(most).min(target - most));
+        let (rows, count) =
+            band(self.first_pass.is_some(), run_end - self.cursor, height, lacking, self.row_seconds, budget);
         let start = Instant::now();
         renderer.render_rows(self.cursor, rows, count)?;
-        renderer.finalize_rows(self.cursor, rows, exposure, tonemap)?;
         let elapsed = start.elapsed();
         self.busy += elapsed;
         let row_samples = rows as f64 * count as f64;
@@ -202,14 +204,7 @@ impl Progressive {
     /// Relights the next band of the restarted pixels ([`Renderer::restart_pixels`]), which
     /// have `theirs` samples: one sample a band until they have all had one, then up to
     /// [`CATCH_UP_SAMPLES`], never past the rest's count or `target`.
-    fn step_region(
-        &mut self,
-        renderer: &mut Renderer,
-        theirs: u32,
-        target: u32,
-        exposure: f32,
-        tonemap: Tonemap,
-    ) -> Result<bool> {
+    fn step_region(&mut self, renderer: &mut Renderer, theirs: u32, target: u32, budget: Duration) -> Result<bool> {
         let Some((first, rows)) = renderer.lagging_rows() else { return Ok(false) };
         let end = first + rows;
         if !(first..end).contains(&self.region_cursor) {
@@ -221,11 +216,10 @@ impl Progressive {
         let count = if self.region_swept { CATCH_UP_SAMPLES.min(target.saturating_sub(theirs)).max(1) } else { 1 };
         let per_row = if self.region_row_seconds > 0.0 { self.region_row_seconds } else { self.row_seconds };
         let wanted =
-            if per_row > 0.0 { (self.budget.as_secs_f64() / (per_row * count as f64)) as u32 } else { MIN_BAND_ROWS };
+            if per_row > 0.0 { (budget.as_secs_f64() / (per_row * count as f64)) as u32 } else { MIN_BAND_ROWS };
         let band = wanted.max(MIN_BAND_ROWS).min(end - self.region_cursor);
         let start = Instant::now();
         renderer.render_rows(self.region_cursor, band, count)?;
-        renderer.finalize_rows(self.region_cursor, band, exposure, tonemap)?;
         // Not counted in the samples per second, which are of whole rows.
         let measured = start.elapsed().as_secs_f64() / (band as f64 * count as f64);
         self.region_row_seconds =
@@ -248,6 +242,37 @@ impl Progressive {
     }
 }
 
+/// The next band of a pass, as (rows, samples), for the `rows_left` rows to the end of the pass
+/// of an image `height` rows tall, which lack `remaining` samples, at `row_seconds` a row and
+/// sample (0 before a measurement). The first pass takes one sample a band, so that the preview
+/// is replaced soonest. Later passes take as many samples as fit `budget` over a quarter of the
+/// image (or the rows left, if fewer), and at least [`SAMPLES_PER_BAND`]: each dispatch pays a
+/// set-up per pixel, so that more samples a pixel waste less, while bands of a quarter still
+/// show the image refining as a whole. Never fewer rows than [`MIN_BAND_ROWS`] (nor more than
+/// are left), nor more samples than `remaining`.
+fn band(
+    first_pass_done: bool,
+    rows_left: u32,
+    height: u32,
+    remaining: u32,
+    row_seconds: f64,
+    budget: Duration,
+) -> (u32, u32) {
+    if row_seconds <= 0.0 {
+        return (MIN_BAND_ROWS.min(rows_left), 1); // the first band measures the device
+    }
+    let budget = budget.as_secs_f64();
+    let count = if first_pass_done {
+        let quarter = (height / 4).max(MIN_BAND_ROWS).min(rows_left);
+        let fits = (budget / (row_seconds * quarter as f64)) as u32;
+        fits.max(SAMPLES_PER_BAND).min(remaining)
+    } else {
+        1
+    };
+    let rows = (budget / (row_seconds * count as f64)) as u32;
+    (rows.max(MIN_BAND_ROWS).min(rows_left), count)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -267,12 +292,34 @@ mod tests {
     #[test]
     fn the_preview_block_is_the_smallest_that_fits_the_budget() {
         let mut progressive = Progressive::new();
-        progressive.set_budget(Duration::from_millis(25));
-        assert_eq!(progressive.preview_block(1000), 4, "before any measurement");
+        let budget = Duration::from_millis(25);
+        assert_eq!(progressive.preview_block(1000, budget), 4, "before any measurement");
         // 1000 rows: 2×2 costs 250 + 100 row-samples, 4×4 62.5 + 100.
         for (row_seconds, block) in [(50e-6, 2), (100e-6, 4), (1e-3, 8)] {
             progressive.row_seconds = row_seconds;
-            assert_eq!(progressive.preview_block(1000), block, "{row_seconds} s a row");
+            assert_eq!(progressive.preview_block(1000, budget), block, "{row_seconds} s a row");
         }
+    }
+
+    #[test]
+    fn a_long_budget_takes_more_samples_a_band_rather_than_more_rows() {
+        let ms = Duration::from_millis;
+        // Before a measurement: a small band of one sample.
+        assert_eq!(band(false, 1024, 1024, 64, 0.0, ms(25)), (MIN_BAND_ROWS, 1));
+        // The first pass: one sample a band, as many rows as fit (26 ms at 0.1 ms a row).
+        assert_eq!(band(false, 1024, 1024, 64, 1e-4, ms(26)), (260, 1));
+        assert_eq!(band(false, 1024, 1024, 64, 1e-4, ms(500)), (1024, 1), "even when more would fit");
+        // Later passes: four samples a band where fewer would fit a quarter of the image...
+        assert_eq!(band(true, 1024, 1024, 60, 1e-4, ms(26)), (65, 4));
+        // ... and as many as fit over a quarter where that is more: 210 ms at 0.1 ms a row
+        // and sample over 256 rows is 8.
+        assert_eq!(band(true, 1024, 1024, 60, 1e-4, ms(210)), (262, 8));
+        // Near the end of a pass, a quarter is what is left: 215 ms over 100 rows is 21.
+        assert_eq!(band(true, 100, 1024, 60, 1e-4, ms(215)), (100, 21));
+        // Never more samples than are missing, never fewer rows than the least band.
+        assert_eq!(band(true, 1024, 1024, 3, 1e-4, ms(26)), (86, 3));
+        assert_eq!(band(true, 1024, 1024, 60, 1e-4, ms(21_000)), (1024, 60));
+        assert_eq!(band(true, 1024, 1024, 60, 1.0, ms(25)), (MIN_BAND_ROWS, 4));
+        assert_eq!(band(true, 5, 1024, 60, 1.0, ms(25)), (5, 4));
     }
 }

@@ -121,6 +121,16 @@ impl ScriptRunner {
         self.next >= self.script.steps.len()
     }
 
+    /// Whether the next step can run at `samples` of `target`: there is one, and it is not a
+    /// wait for samples not yet taken (a wait that could never end is ready: to be refused).
+    pub fn ready(&self, samples: u32, target: u32) -> bool {
+        match self.script.steps.get(self.next) {
+            None => false,
+            Some((_, Step::WaitSpp(spp))) => samples >= *spp || *spp > target,
+            Some(_) => true,
+        }
+    }
+
     /// The next step and its line; `None` when the script is done or waiting for samples. A
     /// wait for more samples than the target would never end, so it is an error, which names
     /// what sets the target: `--exit-after-spp` (`capped`), else the look's or `spp`'s.

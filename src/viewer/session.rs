@@ -5,7 +5,7 @@
 
 use super::compare::{self, Compare, SnapshotView, Subject};
 use super::delta_e::DeltaE;
-use super::progressive::{frame_budget, Progressive};
+use super::progressive::Progressive;
 use super::snapshots::{Capture, Snapshots};
 use crate::environment::{Environment, EnvironmentRef, LoadOptions};
 use crate::gbuffer::GBuffer;
@@ -459,9 +459,7 @@ impl Session {
         renderer.set_noise_threshold(self.shown.noise)?;
         // Its display image starts cleared and is not shown until its first pass has landed
         // (see `compare_ready`).
-        let mut progressive = Progressive::new();
-        progressive.set_budget(frame_budget() / 2);
-        self.progressive.set_budget(frame_budget() / 2);
+        let progressive = Progressive::new();
         self.snapshot_compare = None;
         self.retired.extend(self.compare.replace(Compare { subject, renderer, progressive, packed }));
         Ok(())
@@ -471,7 +469,6 @@ impl Session {
     pub fn compare_off(&mut self) {
         self.snapshot_compare = None;
         self.retired.extend(self.compare.take());
-        self.progressive.set_budget(frame_budget());
     }
 
     /// Lets go of B sides that were replaced or turned off, once the GPU is done with them.
@@ -646,19 +643,19 @@ impl Session {
         Ok(())
     }
 
-    /// Relights one frame's band, if the target is not reached. Returns whether it did.
-    pub fn step(&mut self) -> Result<bool> {
+    /// Relights for about `budget`, shared by the renderers on screen, unless the target is
+    /// reached. Returns whether anything was relit. What it relit is shown once
+    /// [`Self::prepare_display`] has run.
+    pub fn step(&mut self, budget: Duration) -> Result<bool> {
         let target = self.target();
-        let settings = self.document.settings();
-        let (exposure, tonemap) = (settings.exposure, settings.tonemap);
-        let mut stepped = self.progressive.step(&mut self.renderer, target, exposure, tonemap)?;
+        let share = if self.compare.is_some() { budget / 2 } else { budget };
+        let mut stepped = self.progressive.step(&mut self.renderer, target, share)?;
         if let Some(b) = &mut self.compare {
-            stepped |= b.progressive.step(&mut b.renderer, target, exposure, tonemap)?;
+            stepped |= b.progressive.step(&mut b.renderer, target, share)?;
         }
         if self.first_pass_after_change.is_none() && self.samples() > 0 {
             self.first_pass_after_change = Some(self.changed_at.elapsed());
         }
-        self.refresh_denoise()?;
         // The inspector's radiance follows the accumulation, read back at 1, 2, 4, … samples
         // and at the target rather than every frame.
         let samples = self.samples();
@@ -666,6 +663,18 @@ impl Session {
             self.refresh_inspection()?;
         }
         Ok(stepped)
+    }
+
+    /// Makes the display pixels of what was relit since the last draw, and the display filter's
+    /// image when it is on: what the window is about to show.
+    pub fn prepare_display(&mut self) -> Result<()> {
+        let settings = self.document.settings();
+        let (exposure, tonemap) = (settings.exposure, settings.tonemap);
+        self.renderer.finalize_stale(exposure, tonemap)?;
+        if let Some(b) = &self.compare {
+            b.renderer.finalize_stale(exposure, tonemap)?;
+        }
+        self.refresh_denoise()
     }
 
     /// Inspects the picked pixel again, after an edit, an undo or more samples.
@@ -969,4 +978,51 @@ fn shown_image(renderer: &Renderer, denoise: bool) -> &Image {
 /// How a layer is named in the interface: its preset, or "custom".
 pub fn layer_label(layer: &crate::material::look::Layer) -> String {
     layer.preset.clone().unwrap_or_else(|| "custom".to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::ContextOptions;
+    use crate::render::scene::{GBufferSpec, Scene, SceneSpec};
+
+    fn session(ctx: &Context, size: (u32, u32)) -> Session {
+        let spec = SceneSpec {
+            gbuffer: GBufferSpec { builtin_size: Some(size), ..GBufferSpec::default() },
+            ..SceneSpec::default()
+        };
+        let scene = Scene::load(&spec).unwrap();
+        let document = Document::new(scene.look.clone(), None, scene.settings.clone());
+        Session::new(
+            ctx,
+            scene.gbuffer,
+            scene.gbuffer_name,
+            document,
+            scene.environment,
+            Default::default(),
+            scene.recorded,
+        )
+        .unwrap()
+    }
+
+    /// Budgets that change from step to step, as the scheduler's do between interactive frames
+    /// and idle slices, give bands of different counts; every row still reaches the target,
+    /// and none passes it.
+    #[test]
+    fn any_mix_of_budgets_brings_every_row_exactly_to_the_target() {
+        let ctx = Context::new(&ContextOptions::from_env(std::env::var("LOOKDEV_TEST_DEVICE").ok())).unwrap();
+        let mut session = session(&ctx, (48, 96));
+        session.override_target(37);
+        let budgets = [1, 300, 3, 40, 1, 1, 120].map(Duration::from_millis);
+        let mut steps = 0;
+        while session.step(budgets[steps % budgets.len()]).unwrap() {
+            steps += 1;
+            assert!(steps < 5000, "the accumulation never ends: {} spp", session.samples());
+        }
+        assert!(session.converged());
+        let rows: Vec<u32> = (0..session.height()).map(|row| session.renderer.row_samples(row)).collect();
+        assert!(rows.iter().all(|&n| n == 37), "{rows:?}");
+        drop(session);
+        drop(ctx);
+    }
 }

@@ -1,6 +1,7 @@
 //! The view on screen and its CPU copy: the current view's linear values and display pixels,
 //! refreshed as samples land (at 1, 2, 4, … samples, at the target, and at least every
-//! [`REFRESH`] while accumulating) and at once after an edit, never every frame. The copy feeds
+//! [`REFRESH`] while accumulating, but never for more than a tenth of the time) and at once
+//! after an edit, never every frame. The copy feeds
 //! the view's texture (the beauty is shown straight from the renderer's display image
 //! instead), the clipping overlay, the histogram, the value under the cursor and `probe`.
 
@@ -74,6 +75,8 @@ pub struct Views {
     /// was made (only while it is on).
     overlay_of: Option<(View, u32, Edition, bool)>,
     refreshed_at: Instant,
+    /// How long the last refresh of the copy took.
+    cost: Duration,
 }
 
 impl Default for Views {
@@ -87,6 +90,7 @@ impl Default for Views {
             overlay: None,
             overlay_of: None,
             refreshed_at: Instant::now(),
+            cost: Duration::ZERO,
         }
     }
 }
@@ -160,8 +164,14 @@ impl Views {
         if !self.current.follows_samples() || samples == image.samples || samples == 0 {
             return false;
         }
-        super::progressive::read_again(image.samples, samples, session.target())
-            || self.refreshed_at.elapsed() >= REFRESH
+        if samples >= session.target() {
+            return true;
+        }
+        // Reading the copy costs a CPU driver tens of milliseconds at 1024²: while the image
+        // converges, it takes at most a tenth of the time.
+        let since = self.refreshed_at.elapsed();
+        since >= self.cost * 9
+            && (super::progressive::read_again(image.samples, samples, session.target()) || since >= REFRESH)
     }
 
     /// Whether the view's values can be read: a view that follows samples needs a full pass.
@@ -171,6 +181,7 @@ impl Views {
 
     /// Reads the current view's values and makes its display pixels and histogram.
     fn refresh(&mut self, session: &mut Session) -> Result<()> {
+        let started = Instant::now();
         let view = self.current.clone();
         let settings = session.document.settings().clone();
         let Values { channels, linear, shown } = match &view {
@@ -223,6 +234,7 @@ impl Views {
             edition: edition(session),
         });
         self.refreshed_at = Instant::now();
+        self.cost = started.elapsed();
         Ok(())
     }
 
