@@ -28,7 +28,9 @@ pub fn show(ui: &mut egui::Ui, session: &Session, actions: &mut Vec<Action>) -> 
         return add_button(ui);
     };
     let own = document.look().objects.iter().any(|o| o.is_for(object.id()));
-    if !own {
+    if object == ObjectRef::Default && !default_stack_used(session) {
+        ui.label(RichText::new(UNUSED_DEFAULT).color(ui.visuals().warn_fg_color));
+    } else if !own {
         ui.label(RichText::new("Shows the default stack; the first edit gives this object a copy of its own.").weak());
     }
     let mut catcher = stack.shadow_catcher;
@@ -56,13 +58,24 @@ fn objects(ui: &mut egui::Ui, session: &Session, selection: Selection, actions: 
             actions.push(Action::Select(Selection { object: Some(object), layer: top }));
         }
     };
-    row(ui, ObjectRef::Default, "Default stack".to_string());
+    let default = if default_stack_used(session) { "Default stack" } else { "Default stack (no pixel uses it)" };
+    row(ui, ObjectRef::Default, default.to_string());
     for &id in session.objects() {
         let name = session.gbuffer.object_names.get(&id).map(|n| format!(" {n}")).unwrap_or_default();
         let own = look.objects.iter().any(|o| o.id == Some(id));
         let note = if own { "" } else { "  (default stack)" };
         row(ui, ObjectRef::Id(id), format!("{id}{name}{note}"));
     }
+}
+
+/// What the stack panel says of a default stack no pixel shows.
+const UNUSED_DEFAULT: &str =
+    "No pixel uses this stack: every object in the image has a stack of its own. Edits here change only objects added later.";
+
+/// Whether some object in the image has no stack of its own, and so shows the default stack.
+fn default_stack_used(session: &Session) -> bool {
+    let look = session.document.look();
+    session.objects().iter().any(|&id| !look.objects.iter().any(|o| o.id == Some(id)))
 }
 
 fn add_button(ui: &mut egui::Ui) -> bool {
@@ -430,6 +443,60 @@ mod tests {
         assert_eq!(Group::Base.params()[0], Param::BaseColor);
         drop(session);
         drop(ctx);
+    }
+
+    /// The panel's texts for `look` (the built-in one when None) on the 32² shader ball, with
+    /// `object` selected.
+    fn panel_texts(look: Option<&str>, object: ObjectRef) -> Vec<String> {
+        let ctx = Context::new(&ContextOptions::from_env(std::env::var("LOOKDEV_TEST_DEVICE").ok())).unwrap();
+        let look = look.map(|text| {
+            crate::render::scene::LookSource::Given(Box::new(
+                crate::material::look::Look::parse(text, std::path::Path::new("test.toml")).unwrap(),
+            ))
+        });
+        let spec = SceneSpec {
+            gbuffer: GBufferSpec { builtin_size: Some((32, 32)), ..GBufferSpec::default() },
+            look: look.unwrap_or_default(),
+            ..SceneSpec::default()
+        };
+        let scene = Scene::load(&spec).unwrap();
+        let mut document = Document::new(scene.look.clone(), None, scene.settings.clone());
+        document.select(Selection { object: Some(object), layer: Some(0) });
+        let session = Session::new(
+            &ctx,
+            scene.gbuffer,
+            scene.gbuffer_name,
+            document,
+            scene.environment,
+            Default::default(),
+            scene.recorded,
+        )
+        .unwrap();
+        let egui = egui::Context::default();
+        let mut shown = Vec::new();
+        for _ in 0..2 {
+            let output = egui.run_ui(egui::RawInput::default(), |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| show(ui, &session, &mut Vec::new()));
+            });
+            shown.clear();
+            output.shapes.iter().for_each(|clipped| super::super::shape_texts(&clipped.shape, &mut shown));
+        }
+        drop(session);
+        drop(ctx);
+        shown
+    }
+
+    /// The built-in look gives both objects stacks of their own: its default stack is marked as
+    /// one no pixel uses, in the list and over the stack. Where an object shows it, it is not.
+    #[test]
+    fn a_default_stack_no_pixel_uses_is_marked() {
+        let texts = panel_texts(None, ObjectRef::Default);
+        assert!(texts.iter().any(|t| t == "Default stack (no pixel uses it)"), "{texts:?}");
+        assert!(texts.iter().any(|t| t.starts_with("No pixel uses this stack")), "{texts:?}");
+        let ball_only = "[[object]]\n[[object.layer]]\npreset = \"gold\"\n[[object]]\nid = 1\n[[object.layer]]\npreset = \"chrome\"\n";
+        let texts = panel_texts(Some(ball_only), ObjectRef::Default);
+        assert!(texts.iter().any(|t| t == "Default stack"), "{texts:?}");
+        assert!(!texts.iter().any(|t| t.contains("no pixel") || t.starts_with("No pixel")), "{texts:?}");
     }
 
     /// Dropped above or below any layer, dragging up or down, a layer lands next to it, on the
