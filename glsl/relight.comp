@@ -82,6 +82,17 @@ const uint VISIBILITY_ROW = 4096u;
 // With SHADOW_CATCHER, every covered pixel's running sum of its estimates with nothing blocked
 // (rgb): a catcher's own, any other pixel's the same as its accumulation.
 layout(set = 0, binding = 11, rgba32f) uniform image2D unshadowed;
+// Under a noise threshold, the pixels still sampling, in two lists (layers) read and written in
+// turn: a dispatch of the covered list or of one list writes each pixel it leaves active into
+// the other, at its row's place in the covered list plus its rank in the row. Stopped pixels
+// then cost the next dispatches nothing, where in the covered list a SIMD group with one pixel
+// still sampling ran at full cost.
+layout(set = 0, binding = 12, r32ui) uniform uimage2DArray active_lists;
+// Where each row's entries start in the covered list (height + 1 of them), then how many of
+// each row's pixels the list being read holds (height of them).
+layout(set = 0, binding = 13, std430) readonly buffer ActiveRows {
+    uint data[];
+} active_rows;
 // Texels of visibility a pixel has.
 const uint VISIBILITY_TEXELS = (VISIBILITY_SIDE * VISIBILITY_SIDE + 127u) / 128u;
 
@@ -104,12 +115,14 @@ layout(push_constant) uniform Pass {
     uint block;            // SOURCE_PREVIEW: pixels per side of a block
     float noise_threshold; // > 0: stop each pixel once its relative error is below it
     uint min_samples;      // ... but not before this many samples (at least 2)
+    uint list_in;          // SOURCE_ACTIVE: the active list read; those left active go to the other
 } pass;
 
 const uint SOURCE_COVERED = 0u;     // entries of the covered list
 const uint SOURCE_RESTARTED = 1u;   // entries of the restarted list
 const uint SOURCE_PREVIEW = 2u;     // the blocks' top-left pixels, row-major
 const uint SOURCE_BACKGROUND = 3u;  // every pixel, row-major: the background only
+const uint SOURCE_ACTIVE = 4u;      // entries of active list list_in, in the covered list's places
 // Below this mean luminance the error is taken relative to it instead, as relative MSE adds
 // 0.01 to r²: dark pixels need no finer an absolute error, and black ones stop.
 const float BLACK = 0.1;
@@ -399,8 +412,10 @@ void relight(ivec2 pixel, ivec2 size) {
     if (SHADOW_CATCHER != 0u) {
         imageStore(unshadowed, pixel, vec4(open_sum, 0.0));
     }
-    if (adaptive && !stopped && pass.source == SOURCE_COVERED) {
-        atomicAdd(still_active.rows[pixel.y], 1u);
+    if (adaptive && !stopped && (pass.source == SOURCE_COVERED || pass.source == SOURCE_ACTIVE)) {
+        uint slot = active_rows.data[pixel.y] + atomicAdd(still_active.rows[pixel.y], 1u);
+        uint packed = uint(pixel.x) | (uint(pixel.y) << 16);
+        imageStore(active_lists, ivec3(list_texel(slot, size.x), int(1u - pass.list_in)), uvec4(packed));
     }
 }
 
@@ -420,6 +435,14 @@ void main() {
         if (imageLoad(surface, ivec3(pixel, 0)).w <= 0.0) {
             return;
         }
+    } else if (pass.source == SOURCE_ACTIVE) {
+        // Entry i stands in row y's place in the covered list; the row's active pixels fill the
+        // start of it.
+        uint y = uint(unpack_pixel(imageLoad(covered, list_texel(i, size.x)).r).y);
+        if (i - active_rows.data[y] >= active_rows.data[uint(size.y) + 1u + y]) {
+            return;
+        }
+        pixel = unpack_pixel(imageLoad(active_lists, ivec3(list_texel(i, size.x), int(pass.list_in))).r);
     } else if (pass.source == SOURCE_RESTARTED) {
         pixel = unpack_pixel(imageLoad(restarted, list_texel(i, size.x)).r);
     } else {

@@ -163,6 +163,36 @@ fn the_stops_do_not_depend_on_the_split_and_each_pixel_is_a_uniform_render_at_it
     common::gpu::finish(ctx);
 }
 
+/// Pixels restarted alone under a threshold, stopped or still sampling, start again from sample
+/// 0 and stop where a fresh render stops them: with nothing changed, the image ends as a fresh
+/// adaptive render's, bit for bit, and so do the counts. (The pixels still sampling are read
+/// from a compacted list after a row's first pass; a restart sends the row back to the covered
+/// list, or a stopped pixel restarted would never sample again.)
+#[test]
+fn restarted_pixels_under_a_threshold_end_as_a_fresh_render_has_them() {
+    let ctx = common::gpu::context();
+    let noise = Some(NoiseThreshold { threshold: 0.03, min_samples: 8 });
+    let max = 40;
+    let (gbuffer, mut fresh) = scene(&ctx, 7);
+    fresh.set_noise_threshold(noise).unwrap();
+    progressive::accumulate(&mut fresh, max, |_| {}).unwrap();
+    let counts = fresh.read_sample_counts().unwrap();
+
+    let (_, mut edited) = scene(&ctx, 7);
+    edited.set_noise_threshold(noise).unwrap();
+    progressive::accumulate(&mut edited, 20, |_| {}).unwrap();
+    let stopped = edited.read_sample_counts().unwrap().iter().filter(|&&n| n > 0 && n < 20).count();
+    assert!(stopped > 0, "some pixels stopped before the restart");
+    let ball: Vec<u32> = (0..gbuffer.object_id.len() as u32)
+        .filter(|&p| gbuffer.object_id[p as usize] == BALL && gbuffer.coverage[p as usize] > 0.0)
+        .collect();
+    edited.restart_pixels(&ball);
+    progressive::accumulate(&mut edited, max, |_| {}).unwrap();
+    assert_eq!(edited.read_sample_counts().unwrap(), counts);
+    assert_eq!(bits(&edited.read_radiance().unwrap()), bits(&fresh.read_radiance().unwrap()));
+    common::gpu::finish(ctx);
+}
+
 /// At the mean sample count adaptive sampling spent, uniform sampling's relative MSE against a
 /// 1024-spp reference of another seed is higher: the threshold buys the same error with fewer
 /// samples. (Counted in samples, not timed.)

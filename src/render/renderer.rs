@@ -74,6 +74,10 @@ pub struct Renderer {
     /// Under a noise threshold, each row's pixels still active: counted by the row's last pass,
     /// all its covered pixels before one (and its restarted ones added when they restart).
     row_active: Vec<u32>,
+    /// Under a noise threshold, which active list (0 or 1) holds each row's pixels still
+    /// sampling, as its last counted pass left them; None where the next pass reads the
+    /// covered list (before a first pass, and where pixels restarted).
+    row_list: Vec<Option<u32>>,
     /// Whether every row has had a pass since this renderer was made: until then, its display
     /// image holds rows it has not drawn (cleared when made, but not a picture of anything).
     passed: bool,
@@ -165,6 +169,7 @@ impl Renderer {
             seed: 0,
             row_samples: vec![0; height as usize],
             row_active: (0..height).map(|y| lists.covered.row_len(y)).collect(),
+            row_list: vec![None; height as usize],
             lists,
             restarted: None,
             background_rows: vec![false; height as usize],
@@ -343,6 +348,7 @@ impl Renderer {
         for (y, active) in self.row_active.iter_mut().enumerate() {
             *active = self.lists.covered.row_len(y as u32);
         }
+        self.row_list.fill(None);
         self.preview = None;
     }
 
@@ -370,6 +376,10 @@ impl Renderer {
         let list = RowList::from_indices(self.width, self.height, chosen);
         for (y, active) in self.row_active.iter_mut().enumerate() {
             *active = (*active + list.row_len(y as u32)).min(self.lists.covered.row_len(y as u32));
+            if list.row_len(y as u32) > 0 {
+                // The restarted pixels may have stopped: the row's next pass counts them all again.
+                self.row_list[y] = None;
+            }
         }
         self.restarted = Some(Restarted { samples: vec![0; self.height as usize], list, uploaded: false });
     }
@@ -540,11 +550,24 @@ impl Renderer {
         let mut start = first_row;
         while start < end {
             let first_sample = self.row_samples[start as usize];
-            let run_end = (start..end).find(|&r| self.row_samples[r as usize] != first_sample).unwrap_or(end);
+            let list = self.row_list[start as usize];
+            let run_end = (start..end)
+                .find(|&r| self.row_samples[r as usize] != first_sample || self.row_list[r as usize] != list)
+                .unwrap_or(end);
             let mut pushes = self.background_pushes(start, run_end);
             let (first, last) = self.lists.covered.range(start, run_end);
-            pushes.push(self.push(Source::Covered, first, last, first_sample, count));
             let counting = self.noise.is_some();
+            // Under a noise threshold, a row's pass after its first reads the pixels the last
+            // left active, and the pass writes those it leaves into the other list. The covered
+            // list's pass writes list 0.
+            let (source, list_in) = match list {
+                Some(list) if counting => (Source::Active, list),
+                _ => (Source::Covered, 1),
+            };
+            if source == Source::Active {
+                self.lists.set_entering(start, run_end, &self.row_active);
+            }
+            pushes.push(RelightPush { list_in, ..self.push(source, first, last, first_sample, count) });
             if counting {
                 self.lists.clear_active(start, run_end);
             }
@@ -552,6 +575,7 @@ impl Renderer {
             if counting {
                 for y in start..run_end {
                     self.row_active[y as usize] = self.lists.active(y);
+                    self.row_list[y as usize] = Some(1 - list_in);
                 }
             }
             total = total.zip(time).map(|(a, b)| a + b);
@@ -670,6 +694,7 @@ impl Renderer {
             block: 1,
             noise_threshold: self.noise.map_or(0.0, |n| n.threshold),
             min_samples: self.noise.map_or(2, |n| n.min_samples),
+            list_in: 0,
         }
     }
 

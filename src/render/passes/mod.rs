@@ -66,6 +66,9 @@ pub struct Targets {
     pub lobe_sums: Image,
     /// The sums of each estimate's squared luminance (r), for the variance AOV.
     pub moments: Image,
+    /// Under a noise threshold, the two lists of pixels still sampling (relight.comp's
+    /// `active_lists`); 1×1 without the squared luminances, which adaptive sampling needs.
+    pub active_lists: Image,
     /// Each covered pixel's sum of estimates with nothing blocked, where some object catches
     /// shadows (a 1×1 placeholder where none does).
     pub unshadowed: Image,
@@ -78,13 +81,14 @@ pub struct Targets {
 impl Targets {
     pub fn new(ctx: &Context, width: u32, height: u32, accumulate: Accumulate) -> Result<Targets> {
         let float = |layers: u32| Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, width, height, layers, layers > 1);
-        let (lobe_sums, moments) = accumulation_images(ctx, width, height, accumulate)?;
+        let (lobe_sums, moments, active_lists) = accumulation_images(ctx, width, height, accumulate)?;
         Ok(Targets {
             resolved: float(RESOLVED_LAYERS)?,
             accumulation: float(1)?,
             background: float(1)?,
             lobe_sums,
             moments,
+            active_lists,
             unshadowed: Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, 1, 1, 1, false)?,
             radiance: float(1)?,
             display: Image::display(ctx, width, height)?,
@@ -94,7 +98,7 @@ impl Targets {
     /// Makes the AOV accumulations `accumulate` needs.
     pub fn set_accumulate(&mut self, ctx: &Context, accumulate: Accumulate) -> Result<()> {
         let (width, height) = (self.accumulation.width, self.accumulation.height);
-        (self.lobe_sums, self.moments) = accumulation_images(ctx, width, height, accumulate)?;
+        (self.lobe_sums, self.moments, self.active_lists) = accumulation_images(ctx, width, height, accumulate)?;
         Ok(())
     }
 }
@@ -113,12 +117,18 @@ impl Targets {
     }
 }
 
-/// The lobe sums and the squared luminances, each 1×1 when not asked for.
-fn accumulation_images(ctx: &Context, width: u32, height: u32, accumulate: Accumulate) -> Result<(Image, Image)> {
+/// The lobe sums, the squared luminances and the active lists, each 1×1 when not asked for.
+fn accumulation_images(
+    ctx: &Context,
+    width: u32,
+    height: u32,
+    accumulate: Accumulate,
+) -> Result<(Image, Image, Image)> {
     let size = |on: bool| if on { (width, height) } else { (1, 1) };
     let (w, h) = size(accumulate.lobes);
     let lobes = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, w, h, LOBES.len() as u32, true)?;
     let (w, h) = size(accumulate.variance);
     let moments = Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, w, h, 1, false)?;
-    Ok((lobes, moments))
+    let active_lists = Image::new(ctx, vk::Format::R32_UINT, w, h, 2, true)?;
+    Ok((lobes, moments, active_lists))
 }

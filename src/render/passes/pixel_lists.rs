@@ -61,6 +61,9 @@ pub struct PixelLists {
     pub restarted_image: Image,
     /// A host-visible `uint` per row: the pixels the last pass over the row left active.
     pub active: Buffer,
+    /// Host-visible: where each row's entries start in the covered list (`height + 1`), then
+    /// how many pixels of each row the active list a dispatch reads holds (`height`).
+    pub active_rows: Buffer,
 }
 
 impl PixelLists {
@@ -74,7 +77,9 @@ impl PixelLists {
         upload_list(ctx, &covered_image, &covered.pixels)?;
         let restarted_image = list_image(ctx, width, height)?;
         let active = Buffer::staging(ctx, height as u64 * 4)?;
-        Ok(PixelLists { covered, covered_mask, covered_image, restarted_image, active })
+        let mut active_rows = Buffer::staging(ctx, (2 * height as u64 + 1) * 4)?;
+        active_rows.bytes_mut()[..covered.rows.len() * 4].copy_from_slice(bytemuck::cast_slice(&covered.rows));
+        Ok(PixelLists { covered, covered_mask, covered_image, restarted_image, active, active_rows })
     }
 
     /// Writes `list` as the restarted pixels.
@@ -86,6 +91,14 @@ impl PixelLists {
     pub fn clear_active(&mut self, first_row: u32, end_row: u32) {
         let bytes = &mut self.active.bytes_mut()[first_row as usize * 4..end_row as usize * 4];
         bytes.fill(0);
+    }
+
+    /// Sets how many pixels of rows `first_row..end_row` the active list to be read holds.
+    pub fn set_entering(&mut self, first_row: u32, end_row: u32, counts: &[u32]) {
+        let height = self.covered.rows.len() - 1;
+        let at = (height + 1 + first_row as usize) * 4;
+        let rows = &counts[first_row as usize..end_row as usize];
+        self.active_rows.bytes_mut()[at..at + rows.len() * 4].copy_from_slice(bytemuck::cast_slice(rows));
     }
 
     /// The active count of row `y`, as the last pass over it left it.

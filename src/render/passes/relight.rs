@@ -23,8 +23,9 @@ pub const INTERFACE: Interface =
 
 /// Set 0 of `relight.comp`: surface, resolved material, accumulation, background, energy
 /// table, lobe sums, squared luminances, the covered and restarted pixel lists, the active
-/// counts, the visibility and the unshadowed sums. Set 1 is the environment's.
-pub const SET: [BindingKind; 12] = [
+/// counts, the visibility, the unshadowed sums, the active lists and their rows. Set 1 is the
+/// environment's.
+pub const SET: [BindingKind; 14] = [
     BindingKind::StorageImage,
     BindingKind::StorageImage,
     BindingKind::StorageImage,
@@ -37,6 +38,8 @@ pub const SET: [BindingKind; 12] = [
     BindingKind::StorageBuffer,
     BindingKind::StorageImage,
     BindingKind::StorageImage,
+    BindingKind::StorageImage,
+    BindingKind::StorageBuffer,
 ];
 
 /// Which pixels a relight dispatch's invocations stand for (`SOURCE_*` in relight.comp).
@@ -51,6 +54,8 @@ pub enum Source {
     Preview = 2,
     /// Every pixel, row-major: only its background is written.
     Background = 3,
+    /// Entries of an active list, in the covered list's places (under a noise threshold).
+    Active = 4,
 }
 
 /// `Pass` in relight.comp.
@@ -77,9 +82,12 @@ pub struct RelightPush {
     pub noise_threshold: f32,
     /// The samples a pixel takes before it may stop (at least 2).
     pub min_samples: u32,
+    /// The active list (0 or 1) a [`Source::Active`] dispatch reads; the pixels a dispatch of
+    /// it or of the covered list leaves active go to the other.
+    pub list_in: u32,
 }
 
-crate::glsl_struct!(RelightPush as "Pass", 52 bytes {
+crate::glsl_struct!(RelightPush as "Pass", 56 bytes {
     first_sample @ 0,
     sample_count @ 4,
     seed @ 8,
@@ -93,6 +101,7 @@ crate::glsl_struct!(RelightPush as "Pass", 52 bytes {
     block @ 40,
     noise_threshold @ 44,
     min_samples @ 48,
+    list_in @ 52,
 });
 
 /// What the relight kernel accumulates beside the total, for the AOVs that need it
@@ -178,6 +187,8 @@ impl RelightPass {
                 Binding::Buffer(&lists.active),
                 Binding::Image(&gbuffer.visibility),
                 Binding::Image(&targets.unshadowed),
+                Binding::Image(&targets.active_lists),
+                Binding::Buffer(&lists.active_rows),
             ],
         )?;
         let environment_set = pipeline.bind(1, &environment.bindings())?;
