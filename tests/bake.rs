@@ -622,6 +622,39 @@ fn imported_presets_hold_the_values_without_float_noise() {
     }
 }
 
+/// `import --gbuffer` records the bake in the look, relative to it: the look renders on its own,
+/// from any folder, at the bake's size.
+#[test]
+fn an_imported_look_names_its_bake_and_renders_from_anywhere() {
+    let dir = tempfile::tempdir().unwrap();
+    let arg = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let mut gltf = Gltf::new();
+    let red =
+        gltf.material(json!({ "name": "red", "pbrMetallicRoughness": { "baseColorFactor": [0.8, 0.1, 0.1, 1.0] } }));
+    let mesh = gltf.mesh("ball", &[(&uv_sphere(1.0, 16, 8), Some(red))]);
+    gltf.node(json!({ "name": "ball", "mesh": mesh }));
+    camera_looking_down_z(&mut gltf, "front", [0.0, 0.0, 5.5], 30.0, 1.0);
+    let model = gltf.write_glb(dir.path(), "ball");
+    std::fs::create_dir_all(dir.path().join("bakes")).unwrap();
+    std::fs::create_dir_all(dir.path().join("looks/shot")).unwrap();
+    let model = model.to_str().unwrap();
+    assert_success(&lookdev(&["bake", model, "--out", &arg("bakes/ball.exr"), "--size", "48", "40"]));
+    let look = arg("looks/shot/ball.toml");
+    let imported =
+        lookdev(&["import", model, "--presets", &arg("presets"), "--look", &look, "--gbuffer", &arg("bakes/ball.exr")]);
+    assert_success(&imported);
+    let text = std::fs::read_to_string(&look).unwrap();
+    assert!(text.contains("[gbuffer]\nfile = \"../../bakes/ball.exr\"\n"), "{text}");
+    let out = arg("ball.png");
+    let rendered = std::process::Command::new(env!("CARGO_BIN_EXE_lookdev"))
+        .args(["render", "--look", &look, "--spp", "2", "--quiet", "--out", &out])
+        .current_dir(std::env::temp_dir())
+        .output()
+        .unwrap();
+    assert_success(&rendered);
+    assert_eq!(image::image_dimensions(&out).unwrap(), (48, 40));
+}
+
 fn read_exr(path: &Path) -> Vec<[f32; 4]> {
     let image = exr::prelude::read_first_rgba_layer_from_file(
         path,

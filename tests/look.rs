@@ -698,3 +698,22 @@ fn gbuffer_tables_and_object_names_read_write_back_and_resolve() {
         "looks/shot.toml:3: an [[object]] has an id or a name, not both"
     );
 }
+
+/// `[gbuffer] size` keeps the built-in scene's size with the look: it reads back as written,
+/// each side is 1 to 8192 whole pixels, and a file beside it is refused, since a file has its
+/// own size.
+#[test]
+fn the_built_in_scenes_size_is_kept_and_checked() {
+    let look = Look::parse("[gbuffer]\nsize = [320, 200]\n", Path::new(SHOT)).unwrap();
+    assert_eq!(look.gbuffer.size, Some((320, 200)));
+    assert!(look.to_toml().contains("[gbuffer]\nsize = [320, 200]\n"), "{}", look.to_toml());
+    assert_eq!(Look::parse(&look.to_toml(), Path::new(SHOT)).unwrap(), look);
+    for (size, problem) in
+        [("[0, 5]", "each side"), ("[9000, 5]", "each side"), ("[1.5, 5]", "each side"), ("640", "[width, height]")]
+    {
+        let message = error(&format!("[gbuffer]\nsize = {size}\n"));
+        assert!(message.contains(":2:") && message.contains(problem), "{size}: {message}");
+    }
+    let message = error("[gbuffer]\nfile = \"g.exr\"\nsize = [64, 64]\n");
+    assert!(message.contains(":3:") && message.contains("its own size"), "{message}");
+}

@@ -59,6 +59,58 @@ fn left_alone_the_viewer_reaches_its_target_drawing_only_as_the_image_changes() 
     assert!(frames <= 16, "{frames} frames drawn for 48 spp: {report}");
 }
 
+/// A look saved in the viewer keeps its scene, whatever flags opened it: the g-buffer file,
+/// relative to the look, or the built-in scene's size. Either renders on its own, from another
+/// folder, at the size the viewer showed.
+#[test]
+fn a_saved_look_reopens_on_its_scene() {
+    let Some(case) = Case::new() else { return };
+    case.write("deep/er/.keep", "");
+    case.write("file.script", "save-look deep/er/on-file.toml\n");
+    assert_success(&case.view(&["look.toml", "--script", "file.script", "--exit-after-spp", "1"]));
+    let text = std::fs::read_to_string(case.path("deep/er/on-file.toml")).unwrap();
+    assert!(text.contains("[gbuffer]\nfile = \"../../g.exr\"\n"), "{text}");
+
+    case.write("builtin.script", "save-look deep/er/built-in.toml\n");
+    let builtin = case
+        .command(&["view", "--size", "72", "56", "--script", "builtin.script", "--exit-after-spp", "1"])
+        .output()
+        .unwrap();
+    assert_success(&builtin);
+    let text = std::fs::read_to_string(case.path("deep/er/built-in.toml")).unwrap();
+    assert!(text.contains("[gbuffer]\nsize = [72, 56]\n"), "{text}");
+
+    for (look, size) in [("deep/er/on-file.toml", (SIZE, SIZE)), ("deep/er/built-in.toml", (72, 56))] {
+        let out = case.arg(&format!("{look}.png"));
+        let rendered = std::process::Command::new(env!("CARGO_BIN_EXE_lookdev"))
+            .args(["render", "--look", &case.arg(look), "--spp", "1", "--quiet", "--out", &out])
+            .current_dir(std::env::temp_dir())
+            .output()
+            .unwrap();
+        assert_success(&rendered);
+        assert_eq!(image::image_dimensions(&out).unwrap(), size, "{look}");
+    }
+}
+
+/// H hides the side panels, so that the image has the window's width (at 1:1, it then sits
+/// in the middle of the window), and H again brings them back.
+#[test]
+fn h_hides_the_side_panels_and_brings_them_back() {
+    let Some(case) = Case::new() else { return };
+    case.write("tab.script", "key H\nscreenshot hidden.png\nkey H\nscreenshot shown.png\n");
+    let output = case.view(&["look.toml", "--script", "tab.script", "--exit-after-spp", "1"]);
+    assert_success(&output);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let left = |shot: &str| -> u32 {
+        let line = stdout.lines().find(|l| l.contains(&format!("screenshot {shot}"))).unwrap();
+        let at = line.split("the image is at ").nth(1).unwrap();
+        at.split(',').next().unwrap().parse().unwrap()
+    };
+    let window: u32 = WINDOW[0].parse().unwrap();
+    assert_eq!(left("hidden.png"), (window - SIZE) / 2, "{stdout}");
+    assert!(left("shown.png") > left("hidden.png") + 40, "the left panel is back: {stdout}");
+}
+
 /// `view --set` reaches every object, as `render --set` does, also on a look with no default
 /// stack: the pedestal (object 2), which has no stack of its own, takes the red too.
 #[test]

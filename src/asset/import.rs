@@ -1,6 +1,6 @@
 //! Importing an asset's materials: one preset per material, and a look that layers them
 //! through the bake's masks and binds their maps
-//! (docs/commands.md#lookdev-import-modelgltfglb---presets-dir---look-looktoml---force).
+//! (docs/commands.md#lookdev-import-modelgltfglb---presets-dir---look-looktoml---gbuffer-gexr---force).
 //!
 //! The look has one stack, the default one, since every object of a baked asset tells its
 //! materials apart by mask rather than by id. The first material fills; each other material is a
@@ -102,8 +102,16 @@ impl Import {
     }
 
     /// Writes the presets into `presets_dir` and the look to `look_file`, each atomically. Without
-    /// `force`, existing files are refused before anything is written.
-    pub fn write(&self, asset: &Asset, presets_dir: &Path, look_file: &Path, force: bool) -> Result<Vec<PathBuf>> {
+    /// `force`, existing files are refused before anything is written. With `gbuffer`, the look
+    /// names it as its `[gbuffer] file`, relative to the look.
+    pub fn write(
+        &self,
+        asset: &Asset,
+        presets_dir: &Path,
+        look_file: &Path,
+        gbuffer: Option<&Path>,
+        force: bool,
+    ) -> Result<Vec<PathBuf>> {
         let look_folder = match look_file.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
@@ -146,9 +154,15 @@ impl Import {
             written.push(crate::material::library::save_preset(presets_dir, &imported.preset, true)?);
         }
         let from_look = relative_path(&look_folder, presets_dir);
-        let look = self.look(look_file, |name| {
+        let mut look = self.look(look_file, |name| {
             let path = from_look.join(format!("{name}.toml"));
             path.to_string_lossy().replace('\\', "/")
+        });
+        // Relative to the look, as the look reads it back: its folder joined with the way there.
+        look.gbuffer.file = gbuffer.map(|file| {
+            let folder = file.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+            let way = relative_path(&look_folder, folder).join(file.file_name().unwrap_or(file.as_os_str()));
+            look.file.as_deref().and_then(Path::parent).unwrap_or(Path::new("")).join(way)
         });
         let header = format!(
             "# The materials of {}, imported by lookdev import. Bake the g-buffer with\n\

@@ -17,6 +17,10 @@ pub struct ImportArgs {
     /// The look that layers the presets through the bake's masks.
     #[arg(long, value_name = "LOOK.toml")]
     pub look: PathBuf,
+    /// The g-buffer baked from the same model (`lookdev bake`), recorded as the look's
+    /// `[gbuffer] file`, relative to the look, so that the look opens on it.
+    #[arg(long, value_name = "G.exr")]
+    pub gbuffer: Option<PathBuf>,
     /// Replace presets and a look that already exist.
     #[arg(long)]
     pub force: bool,
@@ -35,7 +39,10 @@ pub fn run(args: ImportArgs) -> Result<()> {
             import.unsupported.join(", ")
         ));
     }
-    let written = import.write(&asset, &args.presets, &args.look, args.force)?;
+    if let Some(gbuffer) = args.gbuffer.as_deref().filter(|g| !g.is_file()) {
+        crate::warn(format!("{}: not there yet; bake it before rendering the look", gbuffer.display()));
+    }
+    let written = import.write(&asset, &args.presets, &args.look, args.gbuffer.as_deref(), args.force)?;
     if !args.quiet {
         for material in &import.materials {
             let notes = if material.mapped.notes.is_empty() {

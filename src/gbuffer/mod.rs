@@ -33,6 +33,10 @@ pub use sphere::{SPHERE_FRAME_HALF_EXTENT, SPHERE_ID};
 use crate::visibility::Visibility;
 use std::collections::BTreeMap;
 
+/// The largest side `--size` (or a look's `[gbuffer] size`) gives the built-in shader ball:
+/// 8192² is a 4 GiB g-buffer, made on the CPU, and above most devices' image limits.
+pub const MAX_BUILTIN_SIDE: u32 = 8192;
+
 /// Channel names of the file format.
 pub const NORMAL_CHANNELS: [&str; 3] = ["N.X", "N.Y", "N.Z"];
 pub const VIEW_CHANNELS: [&str; 3] = ["V.X", "V.Y", "V.Z"];

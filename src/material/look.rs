@@ -53,6 +53,8 @@ impl PartialEq for KeyLines {
 pub struct GBufferSettings {
     pub file: Option<PathBuf>,
     pub source: SourceOptions,
+    /// `size = [W, H]`: the built-in shader ball's size, where no file is named.
+    pub size: Option<(u32, u32)>,
 }
 
 /// `[environment]`. `None` means "not set here": the caller's default applies.
@@ -398,6 +400,9 @@ impl Look {
             let relative = file.strip_prefix(folder).unwrap_or(file);
             body.push(format!("file = {}", input::quoted(&relative.to_string_lossy())));
         }
+        if let Some((width, height)) = settings.size {
+            body.push(format!("size = [{width}, {height}]"));
+        }
         if let Some(layer) = &source.layer {
             body.push(format!("layer = {}", input::quoted(layer)));
         }
@@ -557,6 +562,7 @@ struct GBufferFile {
     coverage: Option<Field>,
     id: Option<Field>,
     masks: Option<Field>,
+    size: Option<Field>,
 }
 
 #[derive(Deserialize)]
@@ -665,8 +671,16 @@ fn gbuffer(src: &Source, raw: Option<GBufferFile>, folder: &Path) -> crate::Resu
         masks: src.read("masks", &raw.masks, input::text_list)?.unwrap_or_default(),
     };
     let camera_position = src.read("camera_position", &raw.camera_position, point)?;
+    let file = text("file", &raw.file)?.map(|f| folder.join(f));
+    let size = src.read("size", &raw.size, builtin_size)?;
+    if let (Some(_), Some(_)) = (&file, size) {
+        src.read("size", &raw.size, |_, _| -> Result<(), String> {
+            Err("size = [W, H] sizes the built-in shader ball; a g-buffer file has its own size".into())
+        })?;
+    }
     Ok(GBufferSettings {
-        file: text("file", &raw.file)?.map(|f| folder.join(f)),
+        file,
+        size,
         source: SourceOptions {
             layer: text("layer", &raw.layer)?,
             up: src.read("up", &raw.up, |key, value| Up::parse(&input::text(key, value)?))?,
@@ -676,6 +690,19 @@ fn gbuffer(src: &Source, raw: Option<GBufferFile>, folder: &Path) -> crate::Resu
             no_visibility: false,
         },
     })
+}
+
+/// `[W, H]`, each side 1 to [`crate::gbuffer::MAX_BUILTIN_SIDE`] pixels.
+fn builtin_size(key: &str, value: &toml::Value) -> Result<(u32, u32), String> {
+    let most = crate::gbuffer::MAX_BUILTIN_SIDE;
+    let side = |item: &toml::Value| item.as_integer().filter(|n| (1..=most as i64).contains(n)).map(|n| n as u32);
+    match value {
+        toml::Value::Array(items) if items.len() == 2 => match (side(&items[0]), side(&items[1])) {
+            (Some(width), Some(height)) => Ok((width, height)),
+            _ => Err(format!("{key} = {value}: each side must be a whole number of pixels, 1 to {most}")),
+        },
+        _ => Err(format!("{key} must be [width, height] in pixels, not {}", input::describe(value))),
+    }
 }
 
 /// Three finite numbers `[x, y, z]`.

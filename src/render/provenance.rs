@@ -8,8 +8,9 @@ use crate::material::{Look, Param};
 use crate::render::settings::Settings;
 use std::path::{Path, PathBuf};
 
-/// What a render reads beyond its look and its settings: the g-buffer, as a `[gbuffer]` table,
-/// the AOVs asked for, and the flags no look holds (`--size`, `--supersample`,
+/// What a render reads beyond its look and its settings: the g-buffer, as a `[gbuffer]` table
+/// (the built-in scene by its size),
+/// the AOVs asked for, and the flags no look holds (`--supersample`,
 /// `--no-visibility`, `--env-clamp`, `--env-any-aspect`, `--sampling`).
 #[derive(Clone, Debug, Default)]
 pub struct Recorded {

@@ -14,9 +14,7 @@ use std::path::{Path, PathBuf};
 
 /// Size of the built-in shader ball when no g-buffer is given.
 pub const BUILTIN_SIZE: u32 = 1024;
-/// The largest side `--size` gives the built-in shader ball: 8192² is a 4 GiB g-buffer, made
-/// on the CPU, and above most devices' image limits.
-pub const MAX_BUILTIN_SIDE: u32 = 8192;
+pub use crate::gbuffer::MAX_BUILTIN_SIDE;
 
 /// What a render's inputs are, as a command or the viewer names them. Every command that
 /// renders and the viewer describe their inputs so, and [`Scene::load`] reads them: one way to
@@ -138,9 +136,6 @@ fn recorded(spec: &SceneSpec, look: &Look, settings: &Settings) -> Recorded {
     let g = &spec.gbuffer;
     let file = g.file.clone().or_else(|| look.gbuffer.file.clone());
     let mut flags = Vec::new();
-    if let (None, Some((width, height))) = (&file, g.builtin_size) {
-        flags.extend(["--size".to_string(), width.to_string(), height.to_string()]);
-    }
     if let Some(factor) = g.supersample {
         flags.extend(["--supersample".to_string(), factor.to_string()]);
     }
@@ -160,6 +155,8 @@ fn recorded(spec: &SceneSpec, look: &Look, settings: &Settings) -> Recorded {
         if spec.overrides.aovs.is_empty() { look.render.aovs.clone() } else { Some(spec.overrides.aovs.clone()) };
     Recorded {
         gbuffer: GBufferSettings {
+            // The built-in scene's size, given or by default, so that the look reopens at it.
+            size: file.is_none().then(|| g.builtin_size.or(look.gbuffer.size).unwrap_or((BUILTIN_SIZE, BUILTIN_SIZE))),
             file: file.as_deref().map(provenance::absolute),
             source: SourceOptions {
                 occluders: g
@@ -316,7 +313,7 @@ pub fn read_gbuffer(spec: &GBufferSpec, look: &mut Look, quiet: bool) -> Result<
             (read.gbuffer, path)
         }
         None => {
-            let (width, height) = spec.builtin_size.unwrap_or((BUILTIN_SIZE, BUILTIN_SIZE));
+            let (width, height) = spec.builtin_size.or(look.gbuffer.size).unwrap_or((BUILTIN_SIZE, BUILTIN_SIZE));
             let visibility = !spec.ignore_visibility;
             (GBuffer::shaderball_with(width, height, visibility), PathBuf::from("built-in shader ball"))
         }

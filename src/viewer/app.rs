@@ -69,7 +69,11 @@ impl Inputs {
             LookSource::File(path) => Some(path.clone()),
             _ => None,
         };
-        let mut document = Document::new(scene.look.clone(), path, scene.settings.clone());
+        // The look keeps the scene it is open on: saved, it reopens on the same g-buffer (or
+        // the built-in one at the same size), whatever flags opened it.
+        let mut look = scene.look.clone();
+        look.gbuffer = scene.recorded.gbuffer.clone();
+        let mut document = Document::new(look, path, scene.settings.clone());
         document.select(initial_selection(&document, &covered_object_ids(&scene.gbuffer)));
         Ok(Inputs { scene, document })
     }
@@ -716,8 +720,10 @@ impl Running {
     }
 
     fn open_look(&mut self, path: &Path) -> Result<Option<String>> {
-        let (look, _, warnings) = load_look_for(path, &self.session.gbuffer, &self.session.gbuffer_name)?;
+        let (mut look, _, warnings) = load_look_for(path, &self.session.gbuffer, &self.session.gbuffer_name)?;
         let mut settings = Settings::resolve(&look, &Overrides::default())?;
+        // It is shown on this scene, and saved with it.
+        look.gbuffer = self.session.recorded().gbuffer.clone();
         // Adaptive sampling is the viewer's (`--noise-threshold`), not the look's.
         settings.noise = self.session.document.settings().noise;
         let mut document = Document::new(look, Some(path.to_path_buf()), settings);

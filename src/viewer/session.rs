@@ -302,6 +302,12 @@ impl Session {
         self.renderer.restarted_region()
     }
 
+    /// The g-buffer the session shows, as a look's `[gbuffer]` table records it, and what else
+    /// its renders record.
+    pub fn recorded(&self) -> &crate::render::provenance::Recorded {
+        &self.recorded
+    }
+
     /// Where accumulation stops.
     pub fn target(&self) -> u32 {
         self.target_override.unwrap_or(self.document.settings().spp)

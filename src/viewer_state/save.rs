@@ -40,6 +40,10 @@ impl Document {
         if let Some(EnvironmentRef::File(env)) = &mut look.environment.source {
             *env = folder.join(relative_path(env, folder));
         }
+        let gbuffer = &mut look.gbuffer;
+        for file in gbuffer.file.iter_mut().chain(gbuffer.source.occluders.iter_mut()) {
+            *file = folder.join(relative_path(file, folder));
+        }
         let text = look.to_toml();
         let reread = Look::parse(&text, &file).map_err(|e| Error::input(format!("not saved: {e}")))?;
         if reread != look {

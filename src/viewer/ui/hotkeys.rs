@@ -19,6 +19,7 @@ pub const HOTKEYS: &[Hotkey] = &[
     Hotkey { keys: "Ctrl+Q", does: "Quit (asks about unsaved edits)" },
     Hotkey { keys: "F", does: "Fit the image to the view" },
     Hotkey { keys: "1", does: "Show the image at 1:1 (one image pixel per screen pixel)" },
+    Hotkey { keys: "H", does: "Hide or show the side panels, so that the image has the window's width" },
     Hotkey { keys: "C / Shift+C", does: "Next / previous view (beauty, light AOVs, parameters, N, V, masks, …)" },
     Hotkey { keys: "M", does: "Back to the beauty" },
     Hotkey { keys: "E", does: "False-colour EV view on or off" },

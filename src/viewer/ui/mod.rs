@@ -85,6 +85,8 @@ pub struct Interface {
     pub placement: Option<ImagePlacement>,
     /// The hotkey sheet is open.
     pub hotkeys: bool,
+    /// The side panels are hidden (H), so that the image has the window's width.
+    panels_hidden: bool,
     snapshots: snapshots::Panel,
     environments: environments::Browser,
 }
@@ -122,30 +124,9 @@ impl Interface {
         self.snapshots.prepare(ui.ctx(), frame.session);
         egui::Panel::top("menu").show(ui, |ui| self.menu(ui, frame, actions));
         egui::Panel::bottom("status").show(ui, |ui| self.status(ui, frame));
-        // Each side panel scrolls what does not fit, both ways, rather than growing with its
-        // content: a wide value must not move the image.
-        let scrolled = || egui::ScrollArea::both().auto_shrink([false, false]);
-        egui::Panel::left("stack").default_size(400.0).show(ui, |ui| {
-            scrolled().show(ui, |ui| {
-                let open_browser = layers::show(ui, frame.session, actions);
-                if open_browser {
-                    self.browser.open = true;
-                }
-            })
-        });
-        egui::Panel::right("light").default_size(300.0).show(ui, |ui| {
-            scrolled().show(ui, |ui| {
-                lighting::show(ui, frame.session, &mut self.file_dialog, &mut self.environments.open, actions);
-                ui.separator();
-                compare::show(ui, frame.session, &mut self.file_dialog, actions);
-                ui.separator();
-                inspector::show(ui, frame.session);
-                ui.separator();
-                views::histogram(ui, frame.views);
-                ui.separator();
-                self.snapshots.show(ui, frame.session, actions);
-            })
-        });
+        if !self.panels_hidden {
+            self.side_panels(ui, frame, actions);
+        }
         let snapshot = self.snapshots.shown(frame.session);
         // A snapshot split shows the snapshot's image as B.
         let compare = snapshot.as_ref().map_or(frame.compare_texture, |s| Some(s.texture));
@@ -182,6 +163,35 @@ impl Interface {
         }
     }
 
+    /// The layer stack on the left; lighting, comparison, inspector, histogram and snapshots on
+    /// the right.
+    fn side_panels(&mut self, ui: &mut egui::Ui, frame: &Frame, actions: &mut Vec<Action>) {
+        // Each side panel scrolls what does not fit, both ways, rather than growing with its
+        // content: a wide value must not move the image.
+        let scrolled = || egui::ScrollArea::both().auto_shrink([false, false]);
+        egui::Panel::left("stack").default_size(400.0).show(ui, |ui| {
+            scrolled().show(ui, |ui| {
+                let open_browser = layers::show(ui, frame.session, actions);
+                if open_browser {
+                    self.browser.open = true;
+                }
+            })
+        });
+        egui::Panel::right("light").default_size(300.0).show(ui, |ui| {
+            scrolled().show(ui, |ui| {
+                lighting::show(ui, frame.session, &mut self.file_dialog, &mut self.environments.open, actions);
+                ui.separator();
+                compare::show(ui, frame.session, &mut self.file_dialog, actions);
+                ui.separator();
+                inspector::show(ui, frame.session);
+                ui.separator();
+                views::histogram(ui, frame.views);
+                ui.separator();
+                self.snapshots.show(ui, frame.session, actions);
+            })
+        });
+    }
+
     fn shortcuts(&mut self, ctx: &egui::Context, frame: &Frame, actions: &mut Vec<Action>) {
         if ctx.egui_wants_keyboard_input() {
             return; // typing in a field: its own undo and keys
@@ -213,6 +223,11 @@ impl Interface {
             }
             if input.consume_key(Modifiers::NONE, Key::Questionmark) {
                 self.hotkeys = !self.hotkeys;
+            }
+            // Photoshop and Substance Painter hide their panels with Tab, which egui keeps for
+            // moving the focus between fields: H, for hide.
+            if input.consume_key(Modifiers::NONE, Key::H) {
+                self.panels_hidden = !self.panels_hidden;
             }
             views::shortcuts(input, actions);
             if input.consume_key(Modifiers::NONE, Key::P) {
@@ -299,6 +314,10 @@ impl Interface {
                 }
                 if ui.add(egui::Button::new("Actual pixels (1:1)").shortcut_text("1")).clicked() {
                     self.viewport.actual_pixels();
+                }
+                let hide = egui::Button::selectable(self.panels_hidden, "Hide side panels").shortcut_text("H");
+                if ui.add(hide).clicked() {
+                    self.panels_hidden = !self.panels_hidden;
                 }
                 ui.separator();
                 let denoise =
