@@ -198,7 +198,7 @@ fn snapshot_edit_compare_restore_round_trips_the_look_and_a_second_run_finds_it(
     let column = split_column(&report(&output, "again.png"));
     let right = column + DIVIDER_MARGIN..SIZE;
     assert_matches_render(&region(&shot, right.clone()), &region(&rendered, right));
-    assert_eq!(std::fs::read_to_string(case.path("look.toml")).unwrap(), before, "restored from disk exactly");
+    assert_eq!(std::fs::read_to_string(case.path("look.toml")).unwrap(), kept, "restored from disk exactly");
     assert!(!folder.join("snapshot-1.toml").exists() && !folder.join("snapshot-1.exr").exists(), "deleted");
     assert!(folder.join("before.toml").is_file());
 }
