@@ -111,6 +111,30 @@ fn h_hides_the_side_panels_and_brings_them_back() {
     assert!(left("shown.png") > left("hidden.png") + 40, "the left panel is back: {stdout}");
 }
 
+/// The layer keys, through the interface as a real key press: Ctrl+J duplicates the selected
+/// layer and selects the copy, Ctrl+, hides it, Delete removes it.
+#[test]
+fn layer_keys_duplicate_hide_and_remove_the_selected_layer() {
+    let Some(case) = Case::new() else { return };
+    case.write(
+        "keys.script",
+        "select 1 0\nkey ctrl+J\nkey ctrl+Comma\nsave-look copied.toml\nkey Delete\nsave-look removed.toml\n",
+    );
+    assert_success(&case.view(&["look.toml", "--script", "keys.script", "--exit-after-spp", "1"]));
+    let ball = |file: &str| -> Vec<(Option<String>, bool)> {
+        let look = Look::load(&case.path(file)).unwrap();
+        let stack = look.objects.iter().find(|o| o.id == Some(1)).unwrap();
+        stack.layers.iter().map(|l| (l.preset.clone(), l.enabled)).collect()
+    };
+    let preset = |name: &str| Some(name.to_string());
+    assert_eq!(
+        ball("copied.toml"),
+        [(preset("blue-rubber"), true), (preset("blue-rubber"), false), (preset("gold"), true)],
+        "the copy above the original, hidden"
+    );
+    assert_eq!(ball("removed.toml"), [(preset("blue-rubber"), true), (preset("gold"), true)]);
+}
+
 /// `view --set` reaches every object, as `render --set` does, also on a look with no default
 /// stack: the pedestal (object 2), which has no stack of its own, takes the red too.
 #[test]

@@ -82,6 +82,29 @@ fn add_button(ui: &mut egui::Ui) -> bool {
     ui.button("➕ Add layer…").on_hover_text("Add a layer from the preset library").clicked()
 }
 
+/// The layer keys, as in Photoshop, which most artists' hands know: Ctrl+Shift+N adds a layer
+/// (from the library), Ctrl+J duplicates the selected one, Delete removes it, Ctrl+, hides or
+/// shows it. Returns true when the library should open.
+pub fn shortcuts(input: &mut egui::InputState, session: &Session, actions: &mut Vec<Action>) -> bool {
+    use egui::{Key, KeyboardShortcut, Modifiers};
+    let document = &session.document;
+    let selection = document.selection();
+    let add = input.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::N));
+    let (Some(object), Some(layer)) = (selection.object, selection.layer) else { return add };
+    let Some(stack) = document.stack(object).filter(|s| layer < s.layers.len()) else { return add };
+    if input.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::J)) {
+        actions.push(Action::Edit(Edit::DuplicateLayer { object, layer }));
+        actions.push(Action::Select(Selection { object: Some(object), layer: Some(layer + 1) }));
+    }
+    if input.consume_key(Modifiers::NONE, Key::Delete) && stack.layers.len() > 1 {
+        actions.push(Action::Edit(Edit::RemoveLayer { object, layer }));
+    }
+    if input.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::Comma)) {
+        actions.push(Action::Edit(Edit::SetEnabled { object, layer, enabled: !stack.layers[layer].enabled }));
+    }
+    add
+}
+
 /// The stack, top layer first. Returns true when "Add layer" was clicked.
 fn layer_list(
     ui: &mut egui::Ui,

@@ -230,6 +230,9 @@ impl Interface {
                 self.panels_hidden = !self.panels_hidden;
             }
             views::shortcuts(input, actions);
+            if layers::shortcuts(input, frame.session, actions) {
+                self.browser.open = true;
+            }
             if input.consume_key(Modifiers::NONE, Key::P) {
                 actions.push(Action::Snapshot(None));
             }
