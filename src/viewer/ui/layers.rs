@@ -423,35 +423,7 @@ mod tests {
     /// table's order: each name after its own header and before the next.
     #[test]
     fn the_parameters_show_under_their_groups() {
-        let ctx = Context::new(&ContextOptions::from_env(std::env::var("LOOKDEV_TEST_DEVICE").ok())).unwrap();
-        let spec = SceneSpec {
-            gbuffer: GBufferSpec { builtin_size: Some((32, 32)), ..GBufferSpec::default() },
-            ..SceneSpec::default()
-        };
-        let scene = Scene::load(&spec).unwrap();
-        let mut document = Document::new(scene.look.clone(), None, scene.settings.clone());
-        document.select(Selection { object: Some(ObjectRef::Id(1)), layer: Some(0) });
-        let session = Session::new(
-            &ctx,
-            scene.gbuffer,
-            scene.gbuffer_name,
-            document,
-            scene.environment,
-            Default::default(),
-            scene.recorded,
-        )
-        .unwrap();
-        let egui = egui::Context::default();
-        let mut actions = Vec::new();
-        let mut shown = Vec::new();
-        for _ in 0..2 {
-            // The second pass lays out with the sizes the first measured.
-            let output = egui.run_ui(egui::RawInput::default(), |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| show(ui, &session, &mut actions));
-            });
-            shown.clear();
-            output.shapes.iter().for_each(|clipped| super::super::shape_texts(&clipped.shape, &mut shown));
-        }
+        let shown = panel_texts(None, ObjectRef::Id(1));
         let at =
             |text: &str| shown.iter().position(|t| t == text).unwrap_or_else(|| panic!("no '{text}' in {shown:?}"));
         let headers: Vec<usize> = GROUPS.iter().map(|(group, _)| at(group.name())).collect();
@@ -464,8 +436,6 @@ mod tests {
             }
         }
         assert_eq!(Group::Base.params()[0], Param::BaseColor);
-        drop(session);
-        drop(ctx);
     }
 
     /// The panel's texts for `look` (the built-in one when None) on the 32² shader ball, with
