@@ -649,6 +649,14 @@ impl Session {
         Ok(())
     }
 
+    /// A session on `scene`'s g-buffer and environment, editing `document`: how the unit tests
+    /// of the panels and the session make one.
+    #[cfg(test)]
+    pub fn of_scene(ctx: &Context, scene: crate::render::scene::Scene, document: Document) -> Result<Session> {
+        let crate::render::scene::Scene { gbuffer, gbuffer_name, environment, recorded, .. } = scene;
+        Session::new(ctx, gbuffer, gbuffer_name, document, environment, Default::default(), recorded)
+    }
+
     /// Relights for about `budget`, shared by the renderers on screen, unless the target is
     /// reached. Returns whether anything was relit. What it relit is shown once
     /// [`Self::prepare_display`] has run.
@@ -999,16 +1007,7 @@ mod tests {
         };
         let scene = Scene::load(&spec).unwrap();
         let document = Document::new(scene.look.clone(), None, scene.settings.clone());
-        Session::new(
-            ctx,
-            scene.gbuffer,
-            scene.gbuffer_name,
-            document,
-            scene.environment,
-            Default::default(),
-            scene.recorded,
-        )
-        .unwrap()
+        Session::of_scene(ctx, scene, document).unwrap()
     }
 
     /// Budgets that change from step to step, as the scheduler's do between interactive frames

@@ -455,16 +455,7 @@ mod tests {
         let scene = Scene::load(&spec).unwrap();
         let mut document = Document::new(scene.look.clone(), None, scene.settings.clone());
         document.select(Selection { object: Some(object), layer: Some(0) });
-        let session = Session::new(
-            &ctx,
-            scene.gbuffer,
-            scene.gbuffer_name,
-            document,
-            scene.environment,
-            Default::default(),
-            scene.recorded,
-        )
-        .unwrap();
+        let session = Session::of_scene(&ctx, scene, document).unwrap();
         let egui = egui::Context::default();
         let mut shown = Vec::new();
         for _ in 0..2 {

@@ -142,16 +142,7 @@ mod tests {
         let document = Document::new(scene.look.clone(), None, scene.settings.clone());
         let look_target = document.settings().spp;
         assert_ne!(look_target, 16, "the look's own target differs from the override");
-        let mut session = Session::new(
-            &ctx,
-            scene.gbuffer,
-            scene.gbuffer_name,
-            document,
-            scene.environment,
-            Default::default(),
-            scene.recorded,
-        )
-        .unwrap();
+        let mut session = Session::of_scene(&ctx, scene, document).unwrap();
         let text = panel_text(&session);
         assert!(text.contains(&look_target.to_string()), "{text:?}");
 
