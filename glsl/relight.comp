@@ -93,6 +93,10 @@ layout(set = 0, binding = 12, r32ui) uniform uimage2DArray active_lists;
 layout(set = 0, binding = 13, std430) readonly buffer ActiveRows {
     uint data[];
 } active_rows;
+// Set 2: the lat-long image a BACKGROUND_IMAGE background shows in place of the environment's
+// texels (the environment blurred, or another one: src/environment/backdrop.rs), read
+// bilinearly as env_background reads the environment. A 1×1 placeholder otherwise.
+layout(set = 2, binding = 0, rgba32f) uniform readonly image2D backdrop;
 // Texels of visibility a pixel has.
 const uint VISIBILITY_TEXELS = (VISIBILITY_SIDE * VISIBILITY_SIDE + 127u) / 128u;
 
@@ -105,7 +109,7 @@ layout(push_constant) uniform Pass {
     uint first_sample;     // samples the dispatch's pixels have; 0 starts their accumulation
     uint sample_count;
     uint seed;
-    uint show_background;
+    uint background;       // BACKGROUND_*: what uncovered pixels show
     float cos_rotation;
     float sin_rotation;
     float intensity;
@@ -116,6 +120,9 @@ layout(push_constant) uniform Pass {
     float noise_threshold; // > 0: stop each pixel once its relative error is below it
     uint min_samples;      // ... but not before this many samples (at least 2)
     uint list_in;          // SOURCE_ACTIVE: the active list read; those left active go to the other
+    float background_r;    // BACKGROUND_COLOUR: the linear colour shown
+    float background_g;
+    float background_b;
 } pass;
 
 const uint SOURCE_COVERED = 0u;     // entries of the covered list
@@ -123,6 +130,10 @@ const uint SOURCE_RESTARTED = 1u;   // entries of the restarted list
 const uint SOURCE_PREVIEW = 2u;     // the blocks' top-left pixels, row-major
 const uint SOURCE_BACKGROUND = 3u;  // every pixel, row-major: the background only
 const uint SOURCE_ACTIVE = 4u;      // entries of active list list_in, in the covered list's places
+const uint BACKGROUND_NONE = 0u;         // black; finalize.comp makes it transparent
+const uint BACKGROUND_ENVIRONMENT = 1u;  // the lighting environment
+const uint BACKGROUND_IMAGE = 2u;        // the backdrop image, rotated and scaled as the environment
+const uint BACKGROUND_COLOUR = 3u;       // (background_r, background_g, background_b), as it is
 // Below this mean luminance the error is taken relative to it instead, as relative MSE adds
 // 0.01 to r²: dark pixels need no finer an absolute error, and black ones stop.
 const float BLACK = 0.1;
@@ -285,14 +296,34 @@ bool catches_shadows(ivec2 pixel) {
     return SHADOW_CATCHER != 0u && imageLoad(resolved, ivec3(pixel, 4)).a != 0.0;
 }
 
-// The environment behind `pixel`, where the surface does not cover it all or catches shadows.
+// Bilinear radiance of the backdrop image at uv, as env_background reads the environment.
+vec3 backdrop_background(vec2 uv) {
+    ivec2 xs;
+    ivec2 ys;
+    vec2 t;
+    env_bilinear_taps(uv, imageSize(backdrop), xs, ys, t);
+    vec3 a = imageLoad(backdrop, ivec2(xs.x, ys.x)).rgb;
+    vec3 b = imageLoad(backdrop, ivec2(xs.y, ys.x)).rgb;
+    vec3 c = imageLoad(backdrop, ivec2(xs.x, ys.y)).rgb;
+    vec3 d = imageLoad(backdrop, ivec2(xs.y, ys.y)).rgb;
+    return mix(mix(a, b, t.x), mix(c, d, t.x), t.y);
+}
+
+// The background behind `pixel`, where the surface does not cover it all or catches shadows.
 void write_background(ivec2 pixel) {
     float coverage = imageLoad(surface, ivec3(pixel, 0)).w;
     bool catcher = catches_shadows(pixel);
     vec3 behind = vec3(0.0);
-    if (pass.show_background != 0u && (coverage < 1.0 || catcher)) {
+    if (pass.background != BACKGROUND_NONE && (coverage < 1.0 || catcher)) {
         vec3 view = imageLoad(surface, ivec3(pixel, 1)).xyz;
-        behind = pass.intensity * env_background(env_direction_to_uv(to_environment(-view)));
+        vec2 uv = env_direction_to_uv(to_environment(-view));
+        if (pass.background == BACKGROUND_COLOUR) {
+            behind = vec3(pass.background_r, pass.background_g, pass.background_b);
+        } else if (pass.background == BACKGROUND_IMAGE) {
+            behind = pass.intensity * backdrop_background(uv);
+        } else {
+            behind = pass.intensity * env_background(uv);
+        }
     }
     imageStore(background, pixel, vec4(behind, catcher ? 1.0 : 0.0));
 }

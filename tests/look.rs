@@ -57,7 +57,7 @@ fn unknown_keys_name_the_table_and_the_expected_keys() {
     );
     assert_eq!(
         error("[environment]\nfile = \"a.exr\"\n\nrotaton = 3\n"),
-        "looks/shot.toml:4: unknown key 'rotaton' in [environment] (expected file, builtin, rotation, intensity, background); \
+        "looks/shot.toml:4: unknown key 'rotaton' in [environment] (expected file, builtin, rotation, intensity, background, background_blur, background_environment); \
          did you mean 'rotation'?"
     );
     assert_eq!(
@@ -124,7 +124,7 @@ fn environment_and_render_values_are_checked() {
     assert_eq!(error("[environment]\nrotation = nan\n"), "looks/shot.toml:2: rotation = NaN is not a finite number");
     assert_eq!(
         error("[environment]\nbackground = 1\n"),
-        "looks/shot.toml:2: background must be true or false, not the integer 1"
+        "looks/shot.toml:2: background must be true, false, \"blur\" or a linear colour [r, g, b], not the integer 1"
     );
     assert_eq!(error("[environment]\nfile = 3\n"), "looks/shot.toml:2: file must be a string, not the integer 3");
     assert_eq!(error("[render]\nspp = 0\n"), "looks/shot.toml:2: spp = 0 is out of range [1, 4294967295]");

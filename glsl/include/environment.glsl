@@ -89,22 +89,33 @@ vec4 env_texel(vec2 uv) {
     return imageLoad(env_texels, env_texel_at(uv));
 }
 
-// Bilinear radiance between texel centres, wrapping in u and clamping in v: for the background.
-vec3 env_background(vec2 uv) {
-    ivec2 size = ivec2(env_width, env_height);
+// The texel columns (xs) and rows (ys) around uv in a lat-long image of `size` texels, and the
+// weights between them (t), for a bilinear lookup between texel centres: wrapping in u and
+// clamping in v. Any lat-long image the background shows is read so.
+void env_bilinear_taps(vec2 uv, ivec2 size, out ivec2 xs, out ivec2 ys, out vec2 t) {
     vec2 p = uv * vec2(size) - 0.5;
     vec2 f = floor(p);
-    vec2 t = p - f;
+    t = p - f;
     int x0 = int(f.x);
     int y0 = int(f.y);
     x0 = x0 < 0 ? size.x - 1 : min(x0, size.x - 1);
     int x1 = x0 + 1 == size.x ? 0 : x0 + 1;
     int y1 = clamp(y0 + 1, 0, size.y - 1);
     y0 = clamp(y0, 0, size.y - 1);
-    vec3 a = imageLoad(env_texels, ivec2(x0, y0)).rgb;
-    vec3 b = imageLoad(env_texels, ivec2(x1, y0)).rgb;
-    vec3 c = imageLoad(env_texels, ivec2(x0, y1)).rgb;
-    vec3 d = imageLoad(env_texels, ivec2(x1, y1)).rgb;
+    xs = ivec2(x0, x1);
+    ys = ivec2(y0, y1);
+}
+
+// Bilinear radiance between texel centres, wrapping in u and clamping in v: for the background.
+vec3 env_background(vec2 uv) {
+    ivec2 xs;
+    ivec2 ys;
+    vec2 t;
+    env_bilinear_taps(uv, ivec2(env_width, env_height), xs, ys, t);
+    vec3 a = imageLoad(env_texels, ivec2(xs.x, ys.x)).rgb;
+    vec3 b = imageLoad(env_texels, ivec2(xs.y, ys.x)).rgb;
+    vec3 c = imageLoad(env_texels, ivec2(xs.x, ys.y)).rgb;
+    vec3 d = imageLoad(env_texels, ivec2(xs.y, ys.y)).rgb;
     return mix(mix(a, b, t.x), mix(c, d, t.x), t.y);
 }
 

@@ -159,6 +159,9 @@ pub struct LightingArgs {
     /// Environment radiance scale.
     #[arg(long, value_name = "X")]
     pub intensity: Option<f32>,
+    /// Environment radiance scale in stops: --intensity-stops 1 is --intensity 2.
+    #[arg(long, value_name = "EV", allow_hyphen_values = true, conflicts_with = "intensity", value_parser = intensity_stops)]
+    pub intensity_stops: Option<f32>,
     /// Show black (EXR: transparent) instead of the environment behind the objects.
     #[arg(long)]
     pub no_background: bool,
@@ -210,7 +213,7 @@ fn overrides(lighting: &LightingArgs, sampling: &SamplingArgs, display: &Display
     Overrides {
         environment: lighting.env.clone(),
         rotation: lighting.rotation,
-        intensity: lighting.intensity,
+        intensity: lighting.intensity.or(lighting.intensity_stops.map(f32::exp2)),
         no_background: lighting.no_background,
         spp: sampling.spp,
         seed: sampling.seed,
@@ -222,6 +225,20 @@ fn overrides(lighting: &LightingArgs, sampling: &SamplingArgs, display: &Display
         // `render` and `turntable` set these from their own flags.
         noise_threshold: None,
         min_spp: None,
+    }
+}
+
+/// `--intensity-stops EV`: stops whose intensity, 2^EV, is one an intensity may be.
+fn intensity_stops(text: &str) -> std::result::Result<f32, String> {
+    let stops: f32 = text.parse().map_err(|_| format!("'{text}' is not a number of stops"))?;
+    let most = crate::environment::MAX_INTENSITY.log2();
+    if stops.is_finite() && stops.abs() <= most {
+        Ok(stops)
+    } else {
+        Err(format!(
+            "{text} stops is outside ±{most:.2} (an intensity from 2^-{most:.2} to {:e})",
+            crate::environment::MAX_INTENSITY
+        ))
     }
 }
 

@@ -139,6 +139,7 @@ fn render(
     renderer.set_accumulate(aov::accumulate(aovs))?;
     renderer.set_stacks(&scene.stacks)?;
     renderer.set_lighting(settings.lighting);
+    renderer.set_backdrop(&scene.backdrop)?;
     renderer.set_seed(settings.seed);
     drop(timing);
     let timing = crate::timings::phase("render");

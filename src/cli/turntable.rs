@@ -133,6 +133,7 @@ fn render_frames(
     {
         let (gbuffer_name, sampling) = (Path::new(&scene.gbuffer_name), scene.settings.sampling);
         let mut batch = Batch::with_kernels(ctx, &scene.gbuffer, gbuffer_name, &scene.environment, sampling, kernels)?;
+        batch.set_backdrop(&scene.backdrop)?;
         let (width, height) = (batch.width(), batch.height());
         for frame in first..=last {
             let mut settings = scene.settings.clone();

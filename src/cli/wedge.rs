@@ -109,12 +109,13 @@ pub fn run(args: WedgeArgs) -> Result<()> {
         None if args.lighting.env.is_some() => Look { environment: Default::default(), ..default_look() },
         None => default_look(),
     };
-    let Scene { gbuffer, gbuffer_name, look, environment, settings, .. } =
+    let Scene { gbuffer, gbuffer_name, look, environment, settings, backdrop, .. } =
         Scene::load(&inputs::ball_spec(look, &args.lighting, &args.display, args.spp, &args.model, args.size))?;
     let ctx = super::context(args.device.clone())?;
     let counter = ctx.validation_counter();
     let rows = {
         let mut batch = Batch::new(&ctx, &gbuffer, &gbuffer_name, &environment)?;
+        batch.set_backdrop(&backdrop)?;
         let mut progress = Progress::new((params.len() * values.len()) as u64, "wedge", args.quiet);
         let mut rows = Vec::new();
         for &param in &params {

@@ -6,6 +6,7 @@
 //! centre is −Z and u = 0.75 is +X. A rotation of `r` degrees turns the environment about +Y:
 //! lookups use `R_y(−r)·d`.
 
+pub mod backdrop;
 pub mod builtin;
 pub mod cache;
 pub mod distribution;
@@ -15,6 +16,7 @@ pub mod load;
 pub mod product;
 pub mod sampling;
 
+pub use backdrop::Backdrop;
 pub use builtin::{Builtin, EnvironmentRef};
 pub use distribution::Distribution;
 pub use gpu::{GpuEnvironment, Samplers};

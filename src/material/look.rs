@@ -11,6 +11,7 @@ use serde::Deserialize;
 use super::library::Library;
 use super::params::{Param, Params, Value};
 use super::toml_input::{self as input, Field, Source};
+use crate::environment::backdrop::{self, Backdrop};
 use crate::environment::EnvironmentRef;
 use crate::gbuffer::source::{Channels, SourceOptions, Up};
 use crate::shading::model::{Model, ModelValue};
@@ -67,8 +68,12 @@ pub struct EnvironmentSettings {
     pub rotation: Option<f32>,
     /// Radiance scale, finite and ≥ 0.
     pub intensity: Option<f32>,
-    /// Whether background pixels show the environment.
+    /// Whether background pixels show a background (`background = false`: transparent).
     pub background: Option<bool>,
+    /// What a shown background is (`background = "blur"` with `background_blur`, `[r, g, b]`,
+    /// or `background_environment`); None: the lighting environment. Never set beside
+    /// `background = false`.
+    pub backdrop: Option<Backdrop>,
 }
 
 /// `[render]`. `None` means "not set here": command-line flags and defaults apply.
@@ -385,9 +390,7 @@ impl Look {
         }
         push_float(&mut body, "rotation", env.rotation);
         push_float(&mut body, "intensity", env.intensity);
-        if let Some(background) = env.background {
-            body.push(format!("background = {background}"));
-        }
+        write_background(&mut body, env, self.file.as_deref());
         push_section(lines, "[environment]", body);
     }
 
@@ -573,6 +576,8 @@ struct EnvironmentFile {
     rotation: Option<Field>,
     intensity: Option<Field>,
     background: Option<Field>,
+    background_blur: Option<Field>,
+    background_environment: Option<Field>,
 }
 
 #[derive(Deserialize)]
@@ -624,6 +629,10 @@ fn parse_with(src: Source, library: &Library) -> crate::Result<Look> {
     note("render.min_spp", raw.render.as_ref().and_then(|r| r.min_spp.as_ref()));
     note("render.noise_threshold", raw.render.as_ref().and_then(|r| r.noise_threshold.as_ref()));
     note("environment.file", raw.environment.as_ref().and_then(|e| e.file.as_ref()));
+    note(
+        "environment.background_environment",
+        raw.environment.as_ref().and_then(|e| e.background_environment.as_ref()),
+    );
     let look = Look {
         file: None,
         environment: environment(&src, raw.environment, folder)?,
@@ -642,6 +651,7 @@ fn environment(src: &Source, raw: Option<EnvironmentFile>, folder: &Path) -> cra
         return Ok(EnvironmentSettings::default());
     };
     let file = src.read("file", &raw.file, input::text)?.map(|f| EnvironmentRef::File(folder.join(f)));
+    let (background, backdrop) = background(src, &raw, folder)?;
     let builtin = src.read("builtin", &raw.builtin, |key, value| {
         EnvironmentRef::builtin(&input::text(key, value)?).map_err(|e| format!("{key}: {e}"))
     })?;
@@ -652,8 +662,95 @@ fn environment(src: &Source, raw: Option<EnvironmentFile>, folder: &Path) -> cra
         source: file.or(builtin),
         rotation: src.read("rotation", &raw.rotation, input::number)?,
         intensity: src.read("intensity", &raw.intensity, intensity)?,
-        background: src.read("background", &raw.background, input::boolean)?,
+        background,
+        backdrop,
     })
+}
+
+/// `background`, with `background_blur` and `background_environment`: whether a background is
+/// shown, and what it is where that is not the lighting environment.
+fn background(src: &Source, raw: &EnvironmentFile, folder: &Path) -> crate::Result<(Option<bool>, Option<Backdrop>)> {
+    let blur = src.read("background_blur", &raw.background_blur, |key, value| {
+        let degrees = input::number(key, value)?;
+        backdrop::check_blur(degrees).map(|()| degrees).map_err(|e| e.replacen("background_blur", key, 1))
+    })?;
+    let other = src.read("background_environment", &raw.background_environment, |key, value| {
+        let text = input::text(key, value)?;
+        match text.strip_prefix("builtin:") {
+            Some(name) => EnvironmentRef::builtin(name).map_err(|e| format!("{key}: {e}")),
+            None => Ok(EnvironmentRef::File(folder.join(text))),
+        }
+    })?;
+    let (shown, backdrop) = match src.read("background", &raw.background, background_value)? {
+        None => (None, None),
+        Some((shown, backdrop)) => (Some(shown), backdrop),
+    };
+    let backdrop = match (backdrop, blur) {
+        (Some(Backdrop::Blurred(_)), Some(degrees)) => Some(Backdrop::Blurred(degrees)),
+        (backdrop, None) => backdrop,
+        (_, Some(_)) => {
+            let field = raw.background_blur.as_ref().expect("read above");
+            return Err(src.error(field.span(), "[environment] background_blur needs background = \"blur\""));
+        }
+    };
+    match (other, &backdrop, shown) {
+        (None, _, _) => Ok((shown, backdrop)),
+        (Some(other), None, None | Some(true)) => Ok((shown, Some(Backdrop::Other(other)))),
+        (Some(_), _, _) => {
+            let field = raw.background_environment.as_ref().expect("read above");
+            Err(src.error(
+                field.span(),
+                "[environment] background_environment takes the place of the lighting environment behind the \
+                 objects: it needs background = true or no background, not another background",
+            ))
+        }
+    }
+}
+
+/// A `background` value: true or false, "blur" (at the default blur until `background_blur`
+/// says), or a linear colour [r, g, b].
+fn background_value(key: &str, value: &toml::Value) -> Result<(bool, Option<Backdrop>), String> {
+    match value {
+        toml::Value::Boolean(shown) => Ok((*shown, None)),
+        toml::Value::String(s) if s == "blur" => Ok((true, Some(Backdrop::Blurred(backdrop::DEFAULT_BLUR_DEGREES)))),
+        toml::Value::Array(_) => {
+            let rgb = input::color(key, value)?;
+            backdrop::check_colour(rgb).map_err(|e| format!("{key}: {e}"))?;
+            Ok((true, Some(Backdrop::Colour(rgb))))
+        }
+        _ => Err(format!(
+            "{key} must be true, false, \"blur\" or a linear colour [r, g, b], not {}",
+            input::describe(value)
+        )),
+    }
+}
+
+/// Writes `background` and the keys beside it as [`background`] reads them. A backdrop is left
+/// out with `background = false`, which shows none.
+fn write_background(body: &mut Vec<String>, env: &EnvironmentSettings, look_file: Option<&Path>) {
+    let backdrop = env.backdrop.as_ref().filter(|_| env.background != Some(false));
+    match backdrop {
+        Some(Backdrop::Blurred(degrees)) => {
+            body.push("background = \"blur\"".to_string());
+            push_float(body, "background_blur", Some(*degrees));
+        }
+        Some(Backdrop::Colour(rgb)) => body.push(format!("background = {}", input::value(Value::Color(*rgb)))),
+        _ => {
+            if let Some(shown) = env.background {
+                body.push(format!("background = {shown}"));
+            }
+        }
+    }
+    if let Some(Backdrop::Other(other)) = backdrop {
+        let text = match other {
+            EnvironmentRef::File(file) => {
+                let folder = look_file.and_then(Path::parent).unwrap_or(Path::new(""));
+                file.strip_prefix(folder).unwrap_or(file).to_string_lossy().into_owned()
+            }
+            builtin => builtin.to_string(),
+        };
+        body.push(format!("background_environment = {}", input::quoted(&text)));
+    }
 }
 
 fn gbuffer(src: &Source, raw: Option<GBufferFile>, folder: &Path) -> crate::Result<GBufferSettings> {

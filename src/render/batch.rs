@@ -8,6 +8,7 @@ use super::sampling::Sampling;
 use super::scene::covered_object_ids;
 use super::settings::Settings;
 use super::Renderer;
+use crate::environment::backdrop::Prepared;
 use crate::environment::Environment;
 use crate::gbuffer::GBuffer;
 use crate::gpu::Context;
@@ -47,6 +48,12 @@ impl<'a> Batch<'a> {
     ) -> Result<Batch<'a>> {
         let renderer = Renderer::with_kernels(ctx, gbuffer, environment, sampling, kernels)?;
         Ok(Batch { renderer, gbuffer, gbuffer_name, environment })
+    }
+
+    /// What a shown background is in the renders that follow ([`Renderer::set_backdrop`]):
+    /// the environment until set.
+    pub fn set_backdrop(&mut self, backdrop: &Prepared) -> Result<()> {
+        self.renderer.set_backdrop(backdrop)
     }
 
     /// The renders' width: the g-buffer's, over its supersampling factor.

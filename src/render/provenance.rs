@@ -2,7 +2,7 @@
 //! every setting the flags changed written into it, and the few flags no look holds. Rendering
 //! that look with those flags gives the same image, bit for bit, on the same driver.
 
-use crate::environment::EnvironmentRef;
+use crate::environment::{Backdrop, EnvironmentRef};
 use crate::material::look::{EnvironmentSettings, GBufferSettings, RenderSettings};
 use crate::material::{Look, Param};
 use crate::render::settings::Settings;
@@ -39,6 +39,11 @@ pub fn rendered_look(look: &Look, settings: &Settings, recorded: &Recorded) -> L
         rotation: Some(settings.lighting.rotation_degrees),
         intensity: Some(settings.lighting.intensity),
         background: Some(settings.lighting.background),
+        backdrop: match &settings.backdrop {
+            Backdrop::Environment => None,
+            Backdrop::Other(EnvironmentRef::File(path)) => Some(Backdrop::Other(EnvironmentRef::File(absolute(path)))),
+            backdrop => Some(backdrop.clone()),
+        },
     };
     look.render = RenderSettings {
         spp: Some(settings.spp),

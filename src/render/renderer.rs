@@ -4,9 +4,10 @@
 use super::passes::denoise::DenoisePass;
 use super::passes::finalize::{FinalizePass, FinalizePush};
 use super::passes::pixel_lists::{PixelLists, RowList};
-use super::passes::relight::{RelightPass, Source};
+use super::passes::relight::{Background, RelightPass, Source};
 use super::passes::resolve::ResolvePass;
 use super::passes::Targets;
+use crate::environment::backdrop::Prepared;
 use crate::environment::{Environment, GpuEnvironment, Samplers};
 use crate::gbuffer::gpu::GpuGBuffer;
 use crate::gbuffer::GBuffer;
@@ -28,14 +29,23 @@ pub use super::settings::NoiseThreshold;
 /// The largest preview block: one relit pixel per 8 × 8.
 pub const MAX_PREVIEW_BLOCK: u32 = 8;
 
-/// How the environment lights the scene. Any change restarts accumulation.
+/// How the environment lights the scene. A change of the rotation or the intensity restarts
+/// accumulation; of `background` alone, only the background is written again.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lighting {
     /// Degrees about +Y.
     pub rotation_degrees: f32,
     pub intensity: f32,
-    /// Whether background pixels show the environment.
+    /// Whether background pixels show a background ([`Renderer::set_backdrop`] says which:
+    /// the environment unless set), or are transparent.
     pub background: bool,
+}
+
+impl Lighting {
+    /// Whether `other` lights covered pixels as this does: the same but for the background.
+    pub fn lights_as(&self, other: &Lighting) -> bool {
+        Lighting { background: other.background, ..*self } == *other
+    }
 }
 
 impl Default for Lighting {
@@ -65,8 +75,13 @@ pub struct Renderer {
     lists: PixelLists,
     /// Pixels restarted alone and still catching up with their rows.
     restarted: Option<Restarted>,
-    /// Rows whose background image is that of the current lighting.
+    /// Rows whose background image is that of the current lighting and backdrop.
     background_rows: Vec<bool>,
+    /// What a shown background is: the environment, the image `backdrop_image`, or a colour.
+    backdrop: Background,
+    backdrop_colour: [f32; 3],
+    /// The backdrop's lat-long image, or a 1×1 placeholder.
+    backdrop_image: Image,
     /// Adaptive sampling, when on.
     noise: Option<NoiseThreshold>,
     /// What was asked for with [`Renderer::set_accumulate`]; adaptive sampling adds the variance.
@@ -141,6 +156,7 @@ impl Renderer {
         }
         let gpu_environment = upload_environment(ctx, environment, sampling)?;
         let lists = PixelLists::new(ctx, gbuffer)?;
+        let backdrop_image = backdrop_placeholder(ctx)?;
         let kernels = kernels.wait(ctx)?;
         let resolve = ResolvePass::new(ctx, kernels.resolve, maps);
         let relight = RelightPass::new(
@@ -152,6 +168,7 @@ impl Renderer {
             &targets,
             &lists,
             &gpu_environment,
+            &backdrop_image,
         )?;
         let finalize = FinalizePass::new(kernels.finalize, &gpu_gbuffer, &targets)?;
         let mut renderer = Renderer {
@@ -173,6 +190,9 @@ impl Renderer {
             lists,
             restarted: None,
             background_rows: vec![false; height as usize],
+            backdrop: Background::Environment,
+            backdrop_colour: [0.0; 3],
+            backdrop_image,
             noise: None,
             wanted_accumulate: accumulate,
             passed: false,
@@ -261,6 +281,7 @@ impl Renderer {
             &self.targets,
             &self.lists,
             &self.environment,
+            &self.backdrop_image,
         )?;
         // The background pass writes which pixels catch shadows.
         self.background_rows.fill(false);
@@ -331,13 +352,75 @@ impl Renderer {
         Some((first as u32, rows as u32))
     }
 
-    /// Changes the lighting; accumulation restarts if anything changed.
+    /// Changes the lighting; accumulation restarts if the rotation or the intensity changed.
+    /// Showing the background or not changes only the background, which each row writes anew
+    /// when it is next relit, or every row at once with [`Renderer::write_background`].
     pub fn set_lighting(&mut self, lighting: Lighting) {
-        if lighting != self.lighting {
-            self.lighting = lighting;
-            self.background_rows.fill(false);
-            self.restart();
+        if lighting == self.lighting {
+            return;
         }
+        let restart = !lighting.lights_as(&self.lighting);
+        self.lighting = lighting;
+        self.background_rows.fill(false);
+        if restart {
+            self.restart();
+        } else {
+            self.finalized_rows.get_mut().fill(false);
+        }
+    }
+
+    /// Changes what a shown background is. Covered pixels keep their samples: only the
+    /// background is written again, and every row finalized anew.
+    pub fn set_backdrop(&mut self, backdrop: &Prepared) -> Result<()> {
+        let (kind, colour, image) = match backdrop {
+            Prepared::Environment => (Background::Environment, [0.0; 3], None),
+            Prepared::Colour(rgb) => (Background::Colour, *rgb, None),
+            Prepared::Image(env) => (Background::Image, [0.0; 3], Some(env)),
+        };
+        if let Some(env) = image {
+            let max = self.ctx.info().max_image_dimension_2d;
+            if env.width > max || env.height > max {
+                return Err(crate::Error::input_file(
+                    &env.source,
+                    format!(
+                        "the background is {}x{}, larger than this device's {max} pixel limit",
+                        env.width, env.height
+                    ),
+                ));
+            }
+            let rgba = vk::Format::R32G32B32A32_SFLOAT;
+            let uploaded = Image::filled(&self.ctx, rgba, env.width, env.height, |out: &mut [[f32; 4]]| {
+                for (texel, &[r, g, b]) in out.iter_mut().zip(&env.texels) {
+                    *texel = [r, g, b, 0.0];
+                }
+            })?;
+            self.relight.set_backdrop(&uploaded)?;
+            self.backdrop_image = uploaded;
+        } else if self.backdrop == Background::Image {
+            // The image is let go of; a placeholder is bound in its place.
+            let placeholder = backdrop_placeholder(&self.ctx)?;
+            self.relight.set_backdrop(&placeholder)?;
+            self.backdrop_image = placeholder;
+        }
+        self.backdrop = kind;
+        self.backdrop_colour = colour;
+        self.background_rows.fill(false);
+        self.finalized_rows.get_mut().fill(false);
+        self.write_background()
+    }
+
+    /// Writes the background of every row whose background is not the current one, now,
+    /// rather than when the row is next relit: what the viewer does after a change of the
+    /// background alone, whose samples are all kept, to show it even once they are all taken.
+    /// Nothing happens before the stacks are set (the background pass reads from them which
+    /// pixels catch shadows); rows written are finalized anew.
+    pub fn write_background(&mut self) -> Result<()> {
+        if !self.resolve.has_stacks() || self.background_rows.iter().all(|&done| done) {
+            return Ok(());
+        }
+        self.finalized_rows.get_mut().fill(false);
+        let pushes = self.background_pushes(0, self.height);
+        self.dispatch(&pushes).map(drop)
     }
 
     /// Starts a new accumulation with everything unchanged.
@@ -684,7 +767,7 @@ impl Renderer {
             first_sample,
             sample_count: count,
             seed: self.seed,
-            show_background: self.lighting.background as u32,
+            background: if self.lighting.background { self.backdrop } else { Background::None } as u32,
             cos_rotation: rotation.cos(),
             sin_rotation: rotation.sin(),
             intensity: self.lighting.intensity,
@@ -695,6 +778,9 @@ impl Renderer {
             noise_threshold: self.noise.map_or(0.0, |n| n.threshold),
             min_samples: self.noise.map_or(2, |n| n.min_samples),
             list_in: 0,
+            background_r: self.backdrop_colour[0],
+            background_g: self.backdrop_colour[1],
+            background_b: self.backdrop_colour[2],
         }
     }
 
@@ -1007,6 +1093,11 @@ fn upload_environment(ctx: &Context, environment: &Environment, sampling: Sampli
     let product = sampling.product(&distribution);
     let samplers = product.as_ref().map_or(Samplers::Global, Samplers::Product);
     GpuEnvironment::upload_with(ctx, environment, &distribution, samplers)
+}
+
+/// A 1×1 image bound as the backdrop where none is shown.
+fn backdrop_placeholder(ctx: &Context) -> Result<Image> {
+    Image::new(ctx, vk::Format::R32G32B32A32_SFLOAT, 1, 1, 1, false)
 }
 
 /// The runs of `false` in `flags`: (first index, length) each.

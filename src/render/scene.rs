@@ -1,6 +1,7 @@
 //! The inputs of a render, read and validated before any GPU work starts: g-buffer, look (with
 //! its stacks packed for the objects present), environment and settings.
 
+use crate::environment::backdrop::Prepared;
 use crate::environment::{Environment, EnvironmentRef, LoadOptions};
 use crate::gbuffer::source::{Source, SourceOptions};
 use crate::gbuffer::GBuffer;
@@ -53,6 +54,8 @@ pub struct Scene {
     pub look: Look,
     pub environment: Environment,
     pub settings: Settings,
+    /// The background the settings show, made ready ([`crate::environment::Backdrop::prepare`]).
+    pub backdrop: Prepared,
     pub stacks: PackedStacks,
     /// What the render reads beyond the look and the settings, for the EXR's provenance.
     pub recorded: Recorded,
@@ -79,6 +82,7 @@ impl Scene {
                 _ => e,
             }
         })?;
+        let backdrop = prepare_backdrop(&look, &settings, &environment, &spec.env_options)?;
         let recorded = recorded(spec, &look, &settings);
         // read_gbuffer leaves the visibility out under --no-visibility, of a file and of the ball.
         let ReadGBuffer { gbuffer, name: gbuffer_name, claims } = read_gbuffer(&spec.gbuffer, &mut look, spec.quiet)?;
@@ -90,7 +94,7 @@ impl Scene {
         dark_render_warnings(&gbuffer, &gbuffer_name, &environment, settings.lighting.intensity)
             .into_iter()
             .for_each(crate::warn);
-        Ok(Scene { gbuffer, gbuffer_name, look, environment, settings, stacks, recorded })
+        Ok(Scene { gbuffer, gbuffer_name, look, environment, settings, backdrop, stacks, recorded })
     }
 
     /// Whether this device can hold the g-buffer: checked once the device is known, and
@@ -326,6 +330,27 @@ pub fn read_gbuffer(spec: &GBufferSpec, look: &mut Look, quiet: bool) -> Result<
     }
     let claims = look.resolve_object_names(&gbuffer.object_names, &name)?;
     Ok(ReadGBuffer { gbuffer, name, claims })
+}
+
+/// The background `settings` show, made ready: an environment the look names for it is
+/// reported at the look's line.
+fn prepare_backdrop(
+    look: &Look,
+    settings: &Settings,
+    environment: &Environment,
+    options: &LoadOptions,
+) -> Result<Prepared> {
+    if !settings.lighting.background {
+        return Ok(Prepared::Environment);
+    }
+    settings.backdrop.prepare(environment, options).map_err(|e| crate::Error {
+        message: format!(
+            "{}: [environment] background_environment: {}",
+            look.place("environment.background_environment"),
+            e.message
+        ),
+        ..e
+    })
 }
 
 /// What makes a valid render come out black, or show only the background, each as a warning

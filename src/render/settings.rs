@@ -1,7 +1,7 @@
 //! Render settings: the look's values, overridden by command-line flags, over the defaults.
 
 use super::Lighting;
-use crate::environment::EnvironmentRef;
+use crate::environment::{Backdrop, EnvironmentRef};
 use crate::material::Look;
 use crate::shading::model::Model;
 use crate::shading::tonemap::{Tonemap, MAX_EXPOSURE};
@@ -82,6 +82,8 @@ pub struct Settings {
     /// None: the default built-in environment.
     pub environment: Option<EnvironmentRef>,
     pub lighting: Lighting,
+    /// What the background is where [`Lighting::background`] shows one.
+    pub backdrop: Backdrop,
     pub spp: u32,
     pub seed: u32,
     pub exposure: f32,
@@ -140,6 +142,7 @@ impl Settings {
                 intensity,
                 background: !overrides.no_background && env.background.unwrap_or(true),
             },
+            backdrop: env.backdrop.clone().unwrap_or_default(),
             spp,
             seed: overrides.seed.or(render.seed).unwrap_or(0),
             exposure,

@@ -6,6 +6,7 @@
 
 use super::action::{Action, Answer, Compare};
 use super::compare::SnapshotView;
+use crate::environment::backdrop::{self, Backdrop};
 use crate::environment::EnvironmentRef;
 use crate::material::params::{parse_value, Param, Value};
 use crate::shading::tonemap::Tonemap;
@@ -240,10 +241,7 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
             arity(1)?;
             edit(Edit::SetIntensity(float(args[0])?))
         }
-        "background" => {
-            arity(1)?;
-            edit(Edit::SetBackground(switch(args[0])?))
-        }
+        "background" => edit(background(&args, rest)?),
         "environments" => {
             arity(0)?;
             Ok(Step::Do(Action::ShowEnvironments))
@@ -481,6 +479,39 @@ fn float(text: &str) -> std::result::Result<f32, String> {
     text.parse::<f32>().ok().filter(|v| v.is_finite()).ok_or_else(|| format!("'{text}' is not a finite number"))
 }
 
+/// `background on|off|environment|blur [DEG]|colour R G B|env NAME|FILE`: `rest` is the
+/// whole of the arguments, `args` split at spaces.
+fn background(args: &[&str], rest: &str) -> std::result::Result<Edit, String> {
+    let takes = |n: usize, form: &str| {
+        if args.len() == n {
+            Ok(())
+        } else {
+            Err(format!("'background {form}' takes {} value{}", n - 1, if n == 2 { "" } else { "s" }))
+        }
+    };
+    match args.first().copied() {
+        Some("environment") => takes(1, "environment").map(|()| Edit::SetBackdrop(Backdrop::Environment)),
+        Some("blur") if args.len() == 1 => Ok(Edit::SetBackdrop(Backdrop::Blurred(backdrop::DEFAULT_BLUR_DEGREES))),
+        Some("blur") => takes(2, "blur DEG").and(float(args[1])).map(|d| Edit::SetBackdrop(Backdrop::Blurred(d))),
+        Some("colour" | "color") => {
+            takes(4, "colour R G B")?;
+            let [r, g, b] = [args[1], args[2], args[3]].map(float);
+            Ok(Edit::SetBackdrop(Backdrop::Colour([r?, g?, b?])))
+        }
+        Some("env") => {
+            let name = rest["env".len()..].trim();
+            if name.is_empty() {
+                return Err("'background env' needs an environment file or a built-in's name".to_string());
+            }
+            Ok(Edit::SetBackdrop(Backdrop::Other(EnvironmentRef::parse(name)?)))
+        }
+        Some(word) if args.len() == 1 => switch(word)
+            .map(Edit::SetBackground)
+            .map_err(|_| format!("'{word}' is not on or off, environment, blur [DEG], colour R G B or env NAME|FILE")),
+        _ => Err("'background' takes on, off, environment, blur [DEG], colour R G B or env NAME|FILE".to_string()),
+    }
+}
+
 fn switch(text: &str) -> std::result::Result<bool, String> {
     match text {
         "on" | "true" => Ok(true),
@@ -516,6 +547,43 @@ mod tests {
         assert_eq!(*steps[7], Step::WaitSpp(4));
         assert_eq!(*steps[8], Step::Do(Action::SaveLook(Some(PathBuf::from("out/look.toml")))));
         assert_eq!(*steps[9], Step::Do(Action::Answer(Answer::Discard)));
+    }
+
+    #[test]
+    fn every_background_parses_to_its_edit() {
+        let script = parse(
+            "background off\nbackground environment\nbackground blur\nbackground blur 12\n\
+             background colour 0.1 0.2 0.3\nbackground env builtin:city\n",
+        )
+        .unwrap();
+        let edits: Vec<Edit> = script
+            .steps
+            .iter()
+            .map(|(_, step)| match step {
+                Step::Do(Action::Edit(edit)) => edit.clone(),
+                other => panic!("{other:?} is not an edit"),
+            })
+            .collect();
+        assert_eq!(
+            edits,
+            [
+                Edit::SetBackground(false),
+                Edit::SetBackdrop(Backdrop::Environment),
+                Edit::SetBackdrop(Backdrop::Blurred(backdrop::DEFAULT_BLUR_DEGREES)),
+                Edit::SetBackdrop(Backdrop::Blurred(12.0)),
+                Edit::SetBackdrop(Backdrop::Colour([0.1, 0.2, 0.3])),
+                Edit::SetBackdrop(Backdrop::Other(EnvironmentRef::Builtin("city"))),
+            ]
+        );
+        for (text, expected) in [
+            ("background colour 1 2\n", "'background colour R G B' takes 3 values"),
+            ("background blur soft\n", "'soft' is not a finite number"),
+            ("background env\n", "needs an environment file or a built-in's name"),
+            ("background\n", "'background' takes on, off"),
+        ] {
+            let message = parse(text).unwrap_err().to_string();
+            assert!(message.contains(expected), "{text:?}: {message}");
+        }
     }
 
     #[test]

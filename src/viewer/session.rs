@@ -7,7 +7,8 @@ use super::compare::{self, Compare, SnapshotView, Subject};
 use super::delta_e::DeltaE;
 use super::progressive::Progressive;
 use super::snapshots::{Capture, Snapshots};
-use crate::environment::{Environment, EnvironmentRef, LoadOptions};
+use crate::environment::backdrop::Prepared;
+use crate::environment::{Backdrop, Environment, EnvironmentRef, LoadOptions};
 use crate::gbuffer::GBuffer;
 use crate::gpu::{Context, Image};
 use crate::material::params::Params;
@@ -32,6 +33,7 @@ struct Shown {
     material_revision: u64,
     environment: Option<EnvironmentRef>,
     lighting: Lighting,
+    backdrop: Backdrop,
     seed: u32,
     exposure: f32,
     tonemap: Tonemap,
@@ -122,6 +124,8 @@ pub struct Session {
     masks: Vec<String>,
     env_options: LoadOptions,
     environments: Vec<(Option<EnvironmentRef>, Environment)>,
+    /// The shown backdrop, made ready: what a new B renderer is given.
+    backdrop: Prepared,
     shown: Shown,
     /// When the last change reached the renderer, and how long its first full pass took.
     changed_at: Instant,
@@ -203,6 +207,8 @@ impl Session {
         let settings = document.settings().clone();
         let mut renderer = stacks_renderer(ctx, &gbuffer, &environment, settings.model, settings.sampling, &packed)?;
         renderer.set_lighting(settings.lighting);
+        let backdrop = settings.backdrop.prepare(&environment, &env_options)?;
+        renderer.set_backdrop(&backdrop)?;
         renderer.set_seed(settings.seed);
         renderer.set_noise_threshold(settings.noise)?;
         Ok(Session {
@@ -215,6 +221,7 @@ impl Session {
                 material_revision: document.material_revision(),
                 environment: settings.environment.clone(),
                 lighting: settings.lighting,
+                backdrop: settings.backdrop.clone(),
                 seed: settings.seed,
                 exposure: settings.exposure,
                 tonemap: settings.tonemap,
@@ -228,6 +235,7 @@ impl Session {
             masks,
             env_options,
             environments: vec![(settings.environment, environment)],
+            backdrop,
             changed_at: Instant::now(),
             first_pass_after_change: None,
             inspection: None,
@@ -461,6 +469,7 @@ impl Session {
         let sampling = self.renderer.sampling();
         let mut renderer = stacks_renderer(&self.ctx, &self.gbuffer, environment, subject.model(), sampling, &packed)?;
         renderer.set_lighting(self.shown.lighting);
+        renderer.set_backdrop(&self.backdrop)?;
         renderer.set_seed(self.shown.seed);
         renderer.set_noise_threshold(self.shown.noise)?;
         // Its display image starts cleared and is not shown until its first pass has landed
@@ -547,7 +556,7 @@ impl Session {
         // Whether anything but the materials changes every pixel's image.
         let whole = everything
             || settings.environment != self.shown.environment
-            || settings.lighting != self.shown.lighting
+            || !settings.lighting.lights_as(&self.shown.lighting)
             || settings.seed != self.shown.seed
             || settings.model != self.shown.model
             || settings.noise != self.shown.noise;
@@ -596,7 +605,8 @@ impl Session {
             self.shown.environment = settings.environment.clone();
             restarted = true;
         }
-        if everything || settings.lighting != self.shown.lighting || settings.seed != self.shown.seed {
+        let environment_changed = everything || settings.environment != self.shown.environment;
+        if everything || !settings.lighting.lights_as(&self.shown.lighting) || settings.seed != self.shown.seed {
             self.renderer.set_lighting(settings.lighting);
             self.renderer.set_seed(settings.seed);
             if let Some(b) = &mut self.compare {
@@ -607,6 +617,28 @@ impl Session {
             self.shown.lighting = settings.lighting;
             self.shown.seed = settings.seed;
             restarted = true;
+        }
+        // The background alone: every sample is kept.
+        let blurred = matches!(settings.backdrop, Backdrop::Blurred(_));
+        if everything || settings.backdrop != self.shown.backdrop || (environment_changed && blurred) {
+            let (_, environment) = self.environments.last().expect("the environment on screen is loaded");
+            self.backdrop = settings.backdrop.prepare(environment, &self.env_options)?;
+            self.renderer.set_backdrop(&self.backdrop)?;
+            if let Some(b) = &mut self.compare {
+                b.renderer.set_backdrop(&self.backdrop)?;
+            }
+            self.shown.backdrop = settings.backdrop.clone();
+            self.denoised_at = None;
+        }
+        if settings.lighting != self.shown.lighting {
+            self.renderer.set_lighting(settings.lighting);
+            self.renderer.write_background()?;
+            if let Some(b) = &mut self.compare {
+                b.renderer.set_lighting(settings.lighting);
+                b.renderer.write_background()?;
+            }
+            self.shown.lighting = settings.lighting;
+            self.denoised_at = None;
         }
         if everything || settings.model != self.shown.model {
             self.renderer.set_model(&settings.model)?;

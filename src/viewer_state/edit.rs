@@ -3,6 +3,7 @@
 
 use std::fmt;
 
+use crate::environment::backdrop::{self, Backdrop};
 use crate::environment::EnvironmentRef;
 use crate::material::look::{EnvironmentSettings, Layer, Look, ObjectStack, RenderSettings};
 use crate::material::params::{Param, Params, Value};
@@ -133,8 +134,10 @@ pub enum Edit {
     SetRotation(f32),
     /// Environment radiance scale; finite and ≥ 0.
     SetIntensity(f32),
-    /// Whether background pixels show the environment.
+    /// Whether background pixels show a background ([`Edit::SetBackdrop`] says which).
     SetBackground(bool),
+    /// What the background is; shows it, as `SetBackground(true)` does.
+    SetBackdrop(Backdrop),
     /// The environment: a built-in or an image file; `None` is the default built-in. The file is
     /// not read here: loading it is the viewer's job.
     SetEnvironment(Option<EnvironmentRef>),
@@ -164,6 +167,8 @@ pub enum MergeKey {
     Mask(ObjectRef, usize),
     Rotation,
     Intensity,
+    /// A background colour or blur being dragged.
+    Backdrop,
     Exposure,
     TargetSpp,
     Seed,
@@ -179,6 +184,7 @@ impl Edit {
             Edit::SetMask { object, layer, .. } => Some(MergeKey::Mask(object, layer)),
             Edit::SetRotation(_) => Some(MergeKey::Rotation),
             Edit::SetIntensity(_) => Some(MergeKey::Intensity),
+            Edit::SetBackdrop(Backdrop::Colour(_) | Backdrop::Blurred(_)) => Some(MergeKey::Backdrop),
             Edit::SetExposure(_) => Some(MergeKey::Exposure),
             Edit::SetTargetSpp(_) => Some(MergeKey::TargetSpp),
             Edit::SetSeed(_) => Some(MergeKey::Seed),
@@ -307,6 +313,20 @@ impl State {
                 next.settings.lighting.intensity = intensity;
             }
             Edit::SetBackground(background) => next.settings.lighting.background = background,
+            Edit::SetBackdrop(backdrop) => {
+                match &backdrop {
+                    Backdrop::Environment => {}
+                    Backdrop::Blurred(degrees) => backdrop::check_blur(*degrees)?,
+                    Backdrop::Colour(rgb) => backdrop::check_colour(*rgb)?,
+                    Backdrop::Other(other) => {
+                        if other.file().is_some_and(|f| f.as_os_str().is_empty()) {
+                            return Err("the background environment file must not be empty".to_string());
+                        }
+                    }
+                }
+                next.settings.backdrop = backdrop;
+                next.settings.lighting.background = true;
+            }
             Edit::SetEnvironment(file) => {
                 if file.as_ref().and_then(EnvironmentRef::file).is_some_and(|f| f.as_os_str().is_empty()) {
                     return Err("the environment file must not be empty (none is the default environment)".to_string());
@@ -374,6 +394,7 @@ impl State {
             rotation: keep(env.rotation, s.lighting.rotation_degrees, lighting.rotation_degrees),
             intensity: keep(env.intensity, s.lighting.intensity, lighting.intensity),
             background: keep(env.background, s.lighting.background, lighting.background),
+            backdrop: keep(env.backdrop.as_ref(), s.backdrop.clone(), Backdrop::Environment),
         };
         self.look.render = RenderSettings {
             spp: keep(render.spp, s.spp, DEFAULT_SPP),

@@ -7,7 +7,7 @@ use super::Targets;
 use crate::environment::{self, GpuEnvironment};
 use crate::gbuffer::gpu::GpuGBuffer;
 use crate::gpu::{
-    shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, GlslLayout, Interface,
+    shaders, Binding, BindingKind, Buffer, ComputePipeline, Context, DescriptorSet, GlslLayout, Image, Interface,
 };
 use crate::material::stack::LobesPresent;
 use crate::shading::brdf::EnergyTable;
@@ -18,8 +18,28 @@ use ash::vk;
 use std::sync::Arc;
 
 /// What `relight.comp` and the host agree on.
-pub const INTERFACE: Interface =
-    Interface::compute(&shaders::RELIGHT, &[&SET, &environment::gpu::SET_LAYOUT], Some(RelightPush::GLSL));
+pub const INTERFACE: Interface = Interface::compute(
+    &shaders::RELIGHT,
+    &[&SET, &environment::gpu::SET_LAYOUT, &BACKDROP_SET],
+    Some(RelightPush::GLSL),
+);
+
+/// Set 2 of `relight.comp`: the lat-long image a [`Background::Image`] background shows.
+pub const BACKDROP_SET: [BindingKind; 1] = [BindingKind::StorageImage];
+
+/// What uncovered pixels show (`BACKGROUND_*` in relight.comp).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum Background {
+    /// Nothing: black, which finalize.comp makes transparent.
+    None = 0,
+    /// The lighting environment.
+    Environment = 1,
+    /// The backdrop image (set 2), rotated and scaled as the environment is.
+    Image = 2,
+    /// The push constants' colour, as it is.
+    Colour = 3,
+}
 
 /// Set 0 of `relight.comp`: surface, resolved material, accumulation, background, energy
 /// table, lobe sums, squared luminances, the covered and restarted pixel lists, the active
@@ -66,7 +86,8 @@ pub struct RelightPush {
     pub first_sample: u32,
     pub sample_count: u32,
     pub seed: u32,
-    pub show_background: u32,
+    /// A [`Background`].
+    pub background: u32,
     /// The environment's rotation about +Y.
     pub cos_rotation: f32,
     pub sin_rotation: f32,
@@ -85,13 +106,17 @@ pub struct RelightPush {
     /// The active list (0 or 1) a [`Source::Active`] dispatch reads; the pixels a dispatch of
     /// it or of the covered list leaves active go to the other.
     pub list_in: u32,
+    /// The linear colour a [`Background::Colour`] background shows.
+    pub background_r: f32,
+    pub background_g: f32,
+    pub background_b: f32,
 }
 
-crate::glsl_struct!(RelightPush as "Pass", 56 bytes {
+crate::glsl_struct!(RelightPush as "Pass", 68 bytes {
     first_sample @ 0,
     sample_count @ 4,
     seed @ 8,
-    show_background @ 12,
+    background @ 12,
     cos_rotation @ 16,
     sin_rotation @ 20,
     intensity @ 24,
@@ -102,6 +127,9 @@ crate::glsl_struct!(RelightPush as "Pass", 56 bytes {
     noise_threshold @ 44,
     min_samples @ 48,
     list_in @ 52,
+    background_r @ 56,
+    background_g @ 60,
+    background_b @ 64,
 });
 
 /// What the relight kernel accumulates beside the total, for the AOVs that need it
@@ -124,6 +152,7 @@ pub struct RelightPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
     environment_set: DescriptorSet,
+    backdrop_set: DescriptorSet,
     /// The model, with its energy table when it compensates.
     pub shading: Shading,
     pub accumulate: Accumulate,
@@ -163,6 +192,7 @@ impl RelightPass {
         targets: &Targets,
         lists: &PixelLists,
         environment: &GpuEnvironment,
+        backdrop: &Image,
     ) -> Result<RelightPass> {
         // The energy table is built on the GPU; a placeholder unless the model compensates.
         let (table, energy) = if model.energy_compensation {
@@ -192,10 +222,12 @@ impl RelightPass {
             ],
         )?;
         let environment_set = pipeline.bind(1, &environment.bindings())?;
+        let backdrop_set = pipeline.bind(2, &[Binding::Image(backdrop)])?;
         Ok(RelightPass {
             pipeline,
             set,
             environment_set,
+            backdrop_set,
             shading: Shading::new(*model, energy),
             accumulate,
             _energy: energy_buffer,
@@ -208,10 +240,16 @@ impl RelightPass {
         Ok(())
     }
 
+    /// Binds another backdrop image (set 2).
+    pub fn set_backdrop(&mut self, backdrop: &Image) -> Result<()> {
+        self.backdrop_set = self.pipeline.bind(2, &[Binding::Image(backdrop)])?;
+        Ok(())
+    }
+
     /// Records the pass over the invocations `push.first..push.end`, in as many dispatches as
     /// the workgroup limit needs. Their pixels are disjoint, so the dispatches need no barrier.
     pub fn record(&self, cmd: vk::CommandBuffer, push: &RelightPush) {
-        let sets = [&self.set, &self.environment_set];
+        let sets = [&self.set, &self.environment_set, &self.backdrop_set];
         for (first, end, groups) in super::list_dispatches(push.first, push.end) {
             let chunk = RelightPush { first, end, ..*push };
             self.pipeline.dispatch(cmd, &sets, bytemuck::bytes_of(&chunk), groups);

@@ -1,11 +1,13 @@
-//! The right panel's upper half: the environment (file, rotation, intensity, background) and
-//! the render settings (exposure, tone map, target spp, seed).
+//! The right panel's upper half: the environment (file, rotation, intensity in linear units or
+//! stops, background) and the render settings (exposure, tone map, target spp, seed).
 
 use super::super::action::Action;
 use super::super::session::Session;
 use super::dialogs::{FileDialog, FilePurpose};
 use super::viewport::wrap_degrees;
-use crate::environment::{Builtin, EnvironmentRef};
+use crate::environment::backdrop::{self, Backdrop};
+use crate::environment::{Builtin, EnvironmentRef, MAX_INTENSITY};
+use crate::render::Lighting;
 use crate::shading::tonemap::Tonemap;
 use crate::viewer_state::Edit;
 
@@ -52,11 +54,13 @@ pub fn show(
             actions.push(Action::Drag(Edit::SetIntensity(intensity.max(0.0))));
         }
         ui.end_row();
-        ui.label("Background");
-        let mut background = lighting.background;
-        if ui.checkbox(&mut background, "show the environment").changed() {
-            actions.push(Action::Edit(Edit::SetBackground(background)));
+        ui.label("");
+        if let Some(stops) = stops_control(ui, lighting.intensity) {
+            actions.push(Action::Drag(Edit::SetIntensity(stops.exp2())));
         }
+        ui.end_row();
+        ui.label("Background");
+        background_controls(ui, &lighting, &settings.backdrop, actions);
         ui.end_row();
     });
 
@@ -111,6 +115,74 @@ pub fn show(
     });
     let progress = session.samples() as f32 / session.target().max(1) as f32;
     ui.add(egui::ProgressBar::new(progress.min(1.0)).text(format!("{} / {} spp", session.samples(), session.target())));
+}
+
+/// The intensity in stops, 2^EV = intensity, as a drag value beside the linear slider: the same
+/// value, so each follows the other. Returns the stops dragged to. An intensity of 0 is shown
+/// as the fewest stops an intensity may have.
+fn stops_control(ui: &mut egui::Ui, intensity: f32) -> Option<f32> {
+    let most = MAX_INTENSITY.log2();
+    let mut stops = if intensity > 0.0 { intensity.log2() } else { -most };
+    let drag = egui::DragValue::new(&mut stops).range(-most..=most).speed(0.02).suffix(" stops").max_decimals(2);
+    ui.add(drag).on_hover_text("The intensity in stops: each stop doubles it").changed().then_some(stops)
+}
+
+/// The background's menu (none, environment, blurred, colour, another environment) and the
+/// control of the chosen one: the blur in degrees, the colour, or the environment's name.
+fn background_controls(ui: &mut egui::Ui, lighting: &Lighting, backdrop: &Backdrop, actions: &mut Vec<Action>) {
+    let shown = if lighting.background { backdrop.label() } else { "none" };
+    let choices = [
+        ("none", None),
+        ("environment", Some(Backdrop::Environment)),
+        ("blurred", Some(Backdrop::Blurred(backdrop::DEFAULT_BLUR_DEGREES))),
+        ("colour", Some(Backdrop::Colour([0.18; 3]))),
+        ("other environment", Some(Backdrop::Other(EnvironmentRef::Builtin(Builtin::default_one().name)))),
+    ];
+    ui.vertical(|ui| {
+        egui::ComboBox::from_id_salt("background").selected_text(shown).show_ui(ui, |ui| {
+            for (label, choice) in choices {
+                if !ui.selectable_label(shown == label, label).clicked() || shown == label {
+                    continue;
+                }
+                actions.push(Action::Edit(match choice {
+                    None => Edit::SetBackground(false),
+                    // The kind of background it last was keeps its own values.
+                    Some(choice) if choice.label() == backdrop.label() => Edit::SetBackdrop(backdrop.clone()),
+                    Some(choice) => Edit::SetBackdrop(choice),
+                }));
+            }
+        });
+        if !lighting.background {
+            return;
+        }
+        match backdrop {
+            Backdrop::Environment => {}
+            Backdrop::Blurred(degrees) => {
+                let mut degrees = *degrees;
+                let slider =
+                    egui::Slider::new(&mut degrees, 0.5..=backdrop::MAX_BLUR_DEGREES).suffix("°").max_decimals(1);
+                if ui.add(slider).on_hover_text("The blur's standard deviation").changed() {
+                    actions.push(Action::Drag(Edit::SetBackdrop(Backdrop::Blurred(degrees))));
+                }
+            }
+            Backdrop::Colour(rgb) => {
+                let mut rgb = *rgb;
+                if egui::color_picker::color_edit_button_rgb(ui, &mut rgb).on_hover_text("Linear RGB").changed() {
+                    actions.push(Action::Drag(Edit::SetBackdrop(Backdrop::Colour(rgb.map(|c| c.max(0.0))))));
+                }
+            }
+            Backdrop::Other(other) => {
+                egui::ComboBox::from_id_salt("background environment").selected_text(other.label()).show_ui(ui, |ui| {
+                    for builtin in crate::environment::builtin::BUILTINS {
+                        let choice = EnvironmentRef::Builtin(builtin.name);
+                        if ui.selectable_label(*other == choice, builtin.name).clicked() && *other != choice {
+                            actions.push(Action::Edit(Edit::SetBackdrop(Backdrop::Other(choice))));
+                        }
+                    }
+                });
+            }
+        }
+    });
 }
 
 #[cfg(test)]
