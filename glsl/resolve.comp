@@ -2,7 +2,8 @@
 // Resolves each pixel's layer stack into one material, parameter by parameter (docs/formats.md#looks).
 // A layer's value at a pixel is its own value times, for each parameter bound to a map, the
 // map's value there. The bottom layer fills, and each layer above blends in with
-// w = clamp(opacity·m, 0, 1), where m is its mask (or 1 − mask when inverted; 1 without a mask).
+// w = clamp(opacity·m, 0, 1), where m is its mask after its levels (or 1 − that when inverted;
+// 1 without a mask). A blurred mask is a channel of its own (gbuffer::blur).
 // Runs once per edit, not per sample, over a list of pixels: the covered pixels of the stacks
 // that changed since the last resolve (every other stack resolves as it did before; uncovered
 // pixels are never relit nor read, as the AOVs and the denoiser weigh by coverage, so they keep
@@ -28,15 +29,16 @@ layout(set = 0, binding = 1, r32f) uniform readonly image2DArray channels;
 // The stacks, one texel each (GpuStack): first layer, layer count, whether the object catches
 // shadows. Stack s is texel (s % 1024, s / 1024).
 layout(set = 0, binding = 2, rgba32ui) uniform readonly uimage2D stacks;
-// The layers, eleven texels each (GpuLayer, 176 bytes): the layer's own material (five texels,
+// The layers, twelve texels each (GpuLayer, 192 bytes): the layer's own material (five texels,
 // float bits, as Params::to_gpu lays it out); per value, the layer of `channels` it is
 // multiplied by, or −1 (five); then its mask (a layer of `channels`, or −1), invert, opacity
-// (float bits) and padding. 64 layers a row. Images rather than storage buffers,
+// (float bits) and padding; then the mask's levels (float bits: black, white, gamma, and 1 where
+// they apply). 64 layers a row. Images rather than storage buffers,
 // which a CPU driver reads lane by lane.
 layout(set = 0, binding = 3, rgba32ui) uniform readonly uimage2D layers;
 
 uvec4 layer_texel(uint layer, uint k) {
-    return imageLoad(layers, ivec2((layer & 63u) * 11u + k, layer >> 6));
+    return imageLoad(layers, ivec2((layer & 63u) * 12u + k, layer >> 6));
 }
 
 layout(set = 0, binding = 4, rgba32f) uniform image2DArray resolved;
@@ -56,6 +58,17 @@ layout(push_constant) uniform Pass {
 
 float channel(ivec2 pixel, int layer) {
     return imageLoad(channels, ivec3(pixel, layer)).r;
+}
+
+// The mask value after the layer's levels (MaskAdjust::levels): (m − black) / (white − black),
+// clamped, to the power 1/gamma. Skipped where they change nothing, so that masks outside
+// [0, 1] blend as they always have.
+float mask_levels(float m, vec4 levels) {
+    if (levels.w == 0.0) {
+        return m;
+    }
+    float t = clamp((m - levels.x) / (levels.y - levels.x), 0.0, 1.0);
+    return pow(t, 1.0 / levels.z);
 }
 
 // The layer's material at this pixel: its values, each bound one times its map.
@@ -88,7 +101,7 @@ void main() {
         uint index = stack.x + i;
         uvec4 blend = layer_texel(index, 10u);  // mask, invert, opacity, pad
         int mask = int(blend.x);
-        float m = mask >= 0 ? channel(pixel, mask) : 1.0;
+        float m = mask >= 0 ? mask_levels(channel(pixel, mask), uintBitsToFloat(layer_texel(index, 11u))) : 1.0;
         float w = clamp(uintBitsToFloat(blend.z) * (blend.y != 0u ? 1.0 - m : m), 0.0, 1.0);
         vec4 q[5];
         layer_material(index, pixel, q);

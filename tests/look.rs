@@ -66,8 +66,8 @@ fn unknown_keys_name_the_table_and_the_expected_keys() {
     );
     assert_eq!(
         error("[[object]]\nid = 1\n[[object.layer]]\npreset = \"gold\"\nmaks = \"stripes\"\n"),
-        "looks/shot.toml:5: unknown key 'maks' in [[object.layer]] (expected preset, mask, invert, opacity, enabled, \
-         set, map); did you mean 'mask'?"
+        "looks/shot.toml:5: unknown key 'maks' in [[object.layer]] (expected name, preset, mask, mask_blur, mask_black, \
+         mask_white, mask_gamma, invert, opacity, enabled, set, map); did you mean 'mask'?"
     );
     assert_eq!(
         error("[[object]]\nnmae = \"ball\"\n[[object.layer]]\n"),
@@ -716,4 +716,34 @@ fn the_built_in_scenes_size_is_kept_and_checked() {
     }
     let message = error("[gbuffer]\nfile = \"g.exr\"\nsize = [64, 64]\n");
     assert!(message.contains(":3:") && message.contains("its own size"), "{message}");
+}
+
+#[test]
+fn layer_names_and_mask_adjustments_are_read_written_back_and_checked() {
+    let text = "[[object]]\nid = 1\n[[object.layer]]\npreset = \"gold\"\n[[object.layer]]\nname = \"Worn edges\"\n\
+                preset = \"grime\"\nmask = \"grunge\"\nmask_blur = 2.5\nmask_black = 0.1\nmask_white = 0.8\n\
+                mask_gamma = 1.5\n";
+    let look = Look::parse(text, Path::new(SHOT)).unwrap();
+    let layer = &look.objects[0].layers[1];
+    assert_eq!(layer.name.as_deref(), Some("Worn edges"));
+    let adjust = layer.mask_adjust;
+    assert_eq!((adjust.blur, adjust.black, adjust.white, adjust.gamma), (2.5, 0.1, 0.8, 1.5));
+    assert_eq!(look.objects[0].layers[0].mask_adjust, Default::default(), "unset: no adjustment");
+
+    let written = look.to_toml();
+    assert!(written.contains("name = \"Worn edges\"") && written.contains("mask_gamma = 1.5"), "{written}");
+    assert!(!written.contains("mask_blur = 0"), "only adjustments that change something are written: {written}");
+    assert_eq!(Look::parse(&written, Path::new(SHOT)).unwrap(), look);
+    let mut renamed = look.clone();
+    renamed.objects[0].layers[1].name = None;
+    assert_ne!(renamed, look, "a layer's name is part of the look");
+
+    let layer = |line: &str| format!("[[object]]\n[[object.layer]]\npreset = \"gold\"\n[[object.layer]]\n{line}\n");
+    assert_eq!(
+        error(&layer("mask_black = 0.6\nmask_white = 0.4")),
+        "looks/shot.toml:5: mask_black = 0.6 must be below mask_white = 0.4"
+    );
+    assert_eq!(error(&layer("mask_gamma = 0")), "looks/shot.toml:5: mask_gamma = 0 is out of range [0.1, 10]");
+    assert_eq!(error(&layer("mask_blur = 40")), "looks/shot.toml:5: mask_blur = 40 is out of range [0, 16] (pixels)");
+    assert_eq!(error(&layer("name = 3")), "looks/shot.toml:5: name must be a string, not the integer 3");
 }

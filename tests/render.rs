@@ -169,6 +169,17 @@ fn resolved_params(resolved: &[[f32; 4]], pixels: usize, i: usize) -> Params {
 /// The GPU's per-pixel blend of `stacks` over `gbuffer`, compared with the CPU's value by value;
 /// returns how many covered pixels blend metal with a dielectric.
 fn check_resolve(ctx: &lookdev::gpu::Context, gbuffer: &GBuffer, look: &Look, stacks: &PackedStacks) -> usize {
+    check_resolve_within(ctx, gbuffer, look, stacks, 1e-6)
+}
+
+/// [`check_resolve`], within `tolerance` of each value's magnitude (at least 1).
+fn check_resolve_within(
+    ctx: &lookdev::gpu::Context,
+    gbuffer: &GBuffer,
+    look: &Look,
+    stacks: &PackedStacks,
+    tolerance: f32,
+) -> usize {
     let r = renderer(ctx, gbuffer, &Environment::studio(), look, Lighting::default());
     let resolved = r.read_resolved().unwrap();
     let pixels = gbuffer.pixel_count();
@@ -178,7 +189,7 @@ fn check_resolve(ctx: &lookdev::gpu::Context, gbuffer: &GBuffer, look: &Look, st
         let gpu = resolved_params(&resolved, pixels, i);
         let (a, b) = (cpu.to_gpu(), gpu.to_gpu());
         for k in 0..a.len() {
-            let tolerance = 1e-6 * a[k].abs().max(1.0);
+            let tolerance = tolerance * a[k].abs().max(1.0);
             assert!((a[k] - b[k]).abs() <= tolerance, "pixel {i} value {k}: CPU {} GPU {}", a[k], b[k]);
         }
         if gpu.metallic > 0.05 && gpu.metallic < 0.95 {
@@ -212,6 +223,36 @@ fn gpu_resolve_matches_the_cpu_blend() {
     assert!(spread(&|p| p.base_color[0] - p.base_color[1]) > 0.3, "the hue does not vary");
     assert!(spread(&|p| p.emission[0]) > 1.0, "emission does not vary");
     assert!(spread(&|p| p.sheen) > 0.1);
+    common::gpu::finish(ctx);
+}
+
+/// A mask's blur and levels blend on the GPU as the CPU mirror blends them (the levels' power
+/// may round differently there, so within 1e-5), and they change where the layers show.
+#[test]
+fn gpu_resolve_applies_mask_blur_and_levels_as_the_cpu_does() {
+    let ctx = common::gpu::context();
+    let (gbuffer, plain, _) = shaderball_scene(96);
+    let text = Look::builtin_default_text().replacen(
+        "mask = \"stripes\"\n",
+        "mask = \"stripes\"\nmask_blur = 2.5\nmask_black = 0.2\nmask_white = 0.7\nmask_gamma = 1.8\n",
+        1,
+    );
+    let look = Look::parse(&text, Path::new("adjusted.toml")).unwrap();
+    let ids = lookdev::render::scene::covered_object_ids(&gbuffer);
+    let stacks = PackedStacks::pack(&look, ids.clone(), &gbuffer, Path::new("shader ball")).unwrap();
+    assert!(stacks.channels.contains(&"mask.stripes@blur2.5".to_string()), "{:?}", stacks.channels);
+    let blended = check_resolve_within(&ctx, &gbuffer, &look, &stacks, 1e-5);
+    assert!(blended > 20, "only {blended} pixels blend layers");
+    // The adjustments are at work: the gold's share moves at many pixels.
+    let before = PackedStacks::pack(&plain, ids, &gbuffer, Path::new("shader ball")).unwrap();
+    let moved = (0..gbuffer.pixel_count())
+        .filter(|&i| gbuffer.coverage[i] > 0.0 && gbuffer.object_id[i] == 1)
+        .filter(|&i| {
+            let (a, b) = (before.resolve_gbuffer_pixel(&gbuffer, i), stacks.resolve_gbuffer_pixel(&gbuffer, i));
+            (a.metallic - b.metallic).abs() > 0.05
+        })
+        .count();
+    assert!(moved > 100, "only {moved} pixels changed");
     common::gpu::finish(ctx);
 }
 

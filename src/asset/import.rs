@@ -83,6 +83,8 @@ impl Import {
             .iter()
             .enumerate()
             .map(|(rank, imported)| Layer {
+                // The viewer shows the material's own name, not the preset file's path.
+                name: Some(imported.used.label.clone()),
                 preset: Some(preset_reference(&imported.preset.name)),
                 // The first material fills; the others show through their masks.
                 mask: (rank > 0).then(|| imported.used.channel.clone()),

@@ -13,7 +13,7 @@
 use crate::gbuffer::GBuffer;
 use crate::material::look::{Layer, ObjectStack};
 use crate::material::params::{Param, Params};
-use crate::material::stack::{layer_weights, PackedStacks};
+use crate::material::stack::{layer_weights, mask_channels, PackedStacks};
 use crate::material::Look;
 use crate::render::scene::covered_object_ids;
 use crate::shading::common::luminance;
@@ -205,12 +205,13 @@ fn pixel_findings(
     let mut shown = 0usize;
     // Per rule: the pixels it fails at, and the material at the first of them.
     let mut failed: Vec<(usize, Option<Params>)> = vec![(0, None); rules.len()];
+    let masks = mask_channels(stack, gbuffer);
     for p in 0..gbuffer.pixel_count() {
         let id = gbuffer.object_id[p];
         if gbuffer.coverage[p] <= 0.0 || !look.stack_for(id).is_some_and(|s| std::ptr::eq(s, stack)) {
             continue;
         }
-        let mask_value = |name: &str| gbuffer.masks.get(name).map_or(0.0, |m| m[p]);
+        let mask_value = |key: &str| masks.get(key).map_or(0.0, |m| m[p]);
         if layer_weights(stack, mask_value)[index].is_none_or(|w| w.contribution < 0.5) {
             continue;
         }

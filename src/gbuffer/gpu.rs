@@ -96,13 +96,18 @@ impl GpuGBuffer {
     fn channel_layers(&mut self, ctx: &Context, packed: &PackedStacks) -> Result<&Image> {
         if self.channel_layers.as_ref().is_none_or(|(names, _)| *names != packed.channels) {
             let layers = packed.channels.len().max(1) as u32;
+            let blurred = self.blurred_masks(&packed.channels);
             let image = Image::new(ctx, vk::Format::R32_SFLOAT, self.width, self.height, layers, true)?;
             let width = self.width as usize;
             image.upload_rows(ctx, |layer, first_row, bytes| {
                 let out: &mut [f32] = bytemuck::cast_slice_mut(bytes);
                 match packed.channels.get(layer as usize) {
                     Some(name) => {
-                        let values = self.channels.get(name).expect("pack() checked the masks and maps");
+                        let values = self
+                            .channels
+                            .get(name)
+                            .or_else(|| blurred.get(name))
+                            .expect("pack() checked the masks and maps");
                         let start = first_row as usize * width;
                         out.copy_from_slice(&values[start..start + out.len()]);
                     }
@@ -112,6 +117,17 @@ impl GpuGBuffer {
             self.channel_layers = Some((packed.channels.clone(), image));
         }
         Ok(&self.channel_layers.as_ref().expect("just made").1)
+    }
+
+    /// The blurred masks among `channels` (`mask.stripes@blur2`), made from the g-buffer's.
+    fn blurred_masks(&self, channels: &[String]) -> BTreeMap<String, Vec<f32>> {
+        let blurred = channels.iter().filter_map(|name| {
+            let key = name.strip_prefix(MASK_PREFIX)?;
+            let (mask, sigma) = crate::material::mask::parse_blurred(key)?;
+            let source = self.channels.get(&format!("{MASK_PREFIX}{mask}"))?;
+            Some((name.clone(), super::blur::blur(source, self.width, self.height, sigma)))
+        });
+        blurred.filter(|(name, _)| !self.channels.contains_key(name)).collect()
     }
 
     /// What the resolve of `packed` reads: each pixel's stack ([`Self::stack_index`]) and the

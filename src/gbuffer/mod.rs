@@ -10,6 +10,7 @@
 //! built-in scene (docs/formats.md#the-built-in-scene) without a file, [`GBuffer::sphere`] the
 //! built-in orthographic sphere (docs/formats.md#the-built-in-sphere).
 
+pub mod blur;
 mod frame;
 pub mod gpu;
 mod procedural;
@@ -227,6 +228,32 @@ impl GBuffer {
             return self.masks.get(name).map(Vec::as_slice);
         }
         channel.strip_prefix(MAP_PREFIX).and_then(|name| self.maps.get(name)).map(Vec::as_slice)
+    }
+
+    /// The values of a channel the stacks read: [`GBuffer::layer_channel`], or a blurred mask
+    /// (`mask.stripes@blur2`, [`crate::material::mask::MaskAdjust::channel_key`]) made from it.
+    pub fn stack_channel(&self, channel: &str) -> Option<std::borrow::Cow<'_, [f32]>> {
+        if let Some(values) = self.layer_channel(channel) {
+            return Some(values.into());
+        }
+        let (source, sigma) = self.blurred_source(channel)?;
+        Some(blur::blur(source, self.width, self.height, sigma).into())
+    }
+
+    /// Pixel `index` of [`GBuffer::stack_channel`], without making the whole channel.
+    pub fn stack_channel_at(&self, channel: &str, index: usize) -> Option<f32> {
+        if let Some(values) = self.layer_channel(channel) {
+            return Some(values[index]);
+        }
+        let (source, sigma) = self.blurred_source(channel)?;
+        Some(blur::blur_at(source, self.width, self.height, sigma, index))
+    }
+
+    /// The mask a blurred mask's channel is made from, and the blur's σ.
+    fn blurred_source(&self, channel: &str) -> Option<(&[f32], f32)> {
+        let key = channel.strip_prefix(MASK_PREFIX)?;
+        let (name, sigma) = crate::material::mask::parse_blurred(key)?;
+        Some((self.masks.get(name)?, sigma))
     }
 }
 

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use super::library::Library;
+use super::mask::MaskAdjust;
 use super::params::{Param, Params, Value};
 use super::toml_input::{self as input, Field, Source};
 use crate::environment::backdrop::{self, Backdrop};
@@ -145,6 +146,8 @@ impl ObjectStack {
 /// below.
 #[derive(Clone, Debug)]
 pub struct Layer {
+    /// The layer's own name (`name`), which the viewer shows instead of the preset's.
+    pub name: Option<String>,
     /// The `preset` value as written in the file.
     pub preset: Option<String>,
     /// The preset's values with `[object.layer.set]` applied on top.
@@ -157,6 +160,9 @@ pub struct Layer {
     pub maps: BTreeMap<Param, String>,
     /// The g-buffer channel `mask.<name>`; `None` is 1 everywhere.
     pub mask: Option<String>,
+    /// The mask's blur and levels (`mask_blur`, `mask_black`, `mask_white`, `mask_gamma`),
+    /// applied before `invert` and `opacity`.
+    pub mask_adjust: MaskAdjust,
     pub invert: bool,
     /// In [0, 1].
     pub opacity: f32,
@@ -196,11 +202,13 @@ impl Layer {
     /// a stack on its own.
     pub fn filling(params: Params) -> Layer {
         Layer {
+            name: None,
             preset: None,
             params,
             overrides: Vec::new(),
             maps: BTreeMap::new(),
             mask: None,
+            mask_adjust: MaskAdjust::default(),
             invert: false,
             opacity: 1.0,
             enabled: true,
@@ -215,11 +223,13 @@ impl Layer {
 /// `parse(to_toml(look)) == look` hold.
 impl PartialEq for Layer {
     fn eq(&self, other: &Layer) -> bool {
-        self.preset == other.preset
+        self.name == other.name
+            && self.preset == other.preset
             && self.params == other.params
             && self.overrides == other.overrides
             && self.maps == other.maps
             && self.mask == other.mask
+            && self.mask_adjust == other.mask_adjust
             && self.invert == other.invert
             && self.opacity == other.opacity
             && self.enabled == other.enabled
@@ -234,6 +244,18 @@ impl Look {
     /// writes out.
     pub fn builtin_default_text() -> &'static str {
         DEFAULT_LOOK
+    }
+
+    /// The look with layer `solo` alone in its stack (every other layer of that stack hidden,
+    /// so it fills its objects), as Painter's solo shows one layer; `None` when no layer of the
+    /// look is `solo`. Other stacks are left alone.
+    pub fn soloed(&self, solo: LayerId) -> Option<Look> {
+        let stack = self.objects.iter().position(|o| o.layers.iter().any(|l| l.id == solo))?;
+        let mut look = self.clone();
+        for layer in &mut look.objects[stack].layers {
+            layer.enabled = layer.id == solo;
+        }
+        Some(look)
     }
 
     /// Reads and parses a look file. A missing file is an error naming it.
@@ -491,11 +513,25 @@ impl ObjectStack {
 impl Layer {
     fn write(&self, lines: &mut Vec<String>) {
         lines.push("[[object.layer]]".to_string());
+        if let Some(name) = &self.name {
+            lines.push(format!("name = {}", input::quoted(name)));
+        }
         if let Some(preset) = &self.preset {
             lines.push(format!("preset = {}", input::quoted(preset)));
         }
         if let Some(mask) = &self.mask {
             lines.push(format!("mask = {}", input::quoted(mask)));
+        }
+        let (adjust, identity) = (self.mask_adjust, MaskAdjust::default());
+        for (key, value, default) in [
+            ("mask_blur", adjust.blur, identity.blur),
+            ("mask_black", adjust.black, identity.black),
+            ("mask_white", adjust.white, identity.white),
+            ("mask_gamma", adjust.gamma, identity.gamma),
+        ] {
+            if value != default {
+                lines.push(format!("{key} = {}", input::float(value)));
+            }
         }
         if self.invert {
             lines.push("invert = true".to_string());
@@ -605,8 +641,13 @@ struct ObjectFile {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields, expecting = "an [[object.layer]] table")]
 struct LayerFile {
+    name: Option<Field>,
     preset: Option<Field>,
     mask: Option<Field>,
+    mask_blur: Option<Field>,
+    mask_black: Option<Field>,
+    mask_white: Option<Field>,
+    mask_gamma: Option<Field>,
     invert: Option<Field>,
     opacity: Option<Field>,
     enabled: Option<Field>,
@@ -918,18 +959,47 @@ fn layer(src: &Source, raw: &Field<LayerFile>, library: &Library) -> crate::Resu
         let map = map_name(param.name(), value.get_ref()).map_err(|problem| src.error(value.span(), problem))?;
         maps.insert(param, map);
     }
+    let mask_adjust = mask_adjust(src, fields)?;
     Ok(Layer {
+        name: src.read("name", &fields.name, input::text)?,
         preset,
         params,
         overrides,
         maps,
         mask: src.read("mask", &fields.mask, input::text)?,
+        mask_adjust,
         invert: src.read("invert", &fields.invert, input::boolean)?.unwrap_or(false),
         opacity: src.read("opacity", &fields.opacity, unit_interval)?.unwrap_or(1.0),
         enabled: src.read("enabled", &fields.enabled, input::boolean)?.unwrap_or(true),
         line: src.line(raw.span().start),
         id: LayerId::new(),
     })
+}
+
+/// The layer's `mask_*` keys, each checked on its own and then together (black below white).
+fn mask_adjust(src: &Source, fields: &LayerFile) -> crate::Result<MaskAdjust> {
+    let identity = MaskAdjust::default();
+    let adjust = MaskAdjust {
+        blur: src.read("mask_blur", &fields.mask_blur, input::number)?.unwrap_or(identity.blur),
+        black: src.read("mask_black", &fields.mask_black, input::number)?.unwrap_or(identity.black),
+        white: src.read("mask_white", &fields.mask_white, input::number)?.unwrap_or(identity.white),
+        gamma: src.read("mask_gamma", &fields.mask_gamma, input::number)?.unwrap_or(identity.gamma),
+    };
+    if let Err(problem) = adjust.check() {
+        // The message starts with the key it is about.
+        let keys = [
+            ("mask_blur", &fields.mask_blur),
+            ("mask_black", &fields.mask_black),
+            ("mask_white", &fields.mask_white),
+            ("mask_gamma", &fields.mask_gamma),
+        ];
+        let written = keys.iter().filter_map(|(key, field)| field.as_ref().map(|f| (key, f)));
+        let mut written: Vec<_> = written.collect();
+        written.sort_by_key(|(key, _)| !problem.starts_with(*key));
+        let span = written.first().map_or(0..0, |(_, f)| f.span());
+        return Err(src.error(span, problem));
+    }
+    Ok(adjust)
 }
 
 fn unknown_param(name: &str, table: &str) -> String {

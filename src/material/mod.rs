@@ -2,6 +2,7 @@
 
 pub mod library;
 pub mod look;
+pub mod mask;
 pub mod params;
 pub mod physical;
 pub mod preset;

@@ -4,6 +4,7 @@
 //! for tests and for inspecting pixels.
 
 use super::look::{Layer, Look, ObjectStack};
+use super::mask::MaskAdjust;
 use super::params::{Param, Params, GPU_FLOATS};
 use crate::gbuffer::{GBuffer, MapSource, MAP_PREFIX, MASK_PREFIX};
 use crate::{Error, Result};
@@ -13,8 +14,9 @@ use std::path::Path;
 /// No channel: a layer without a mask, or a value bound to no map.
 const NONE: i32 = -1;
 
-/// One layer as `resolve.comp` reads it: eleven RGBA32_UINT texels of its `layers` image, in
-/// this order, floats as their bits (texels 0–4 `params`, 5–9 `maps`, 10 the rest).
+/// One layer as `resolve.comp` reads it: twelve RGBA32_UINT texels of its `layers` image, in
+/// this order, floats as their bits (texels 0–4 `params`, 5–9 `maps`, 10 the mask's channel,
+/// invert and opacity, 11 its levels).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GpuLayer {
@@ -27,12 +29,26 @@ pub struct GpuLayer {
     pub invert: u32,
     pub opacity: f32,
     pub pad: u32,
+    /// The mask's levels ([`MaskAdjust`]): black point, white point, gamma, and 1 where they
+    /// change something (0: the mask is used as it is).
+    pub levels: [f32; 4],
 }
 
 const _: () = assert!(std::mem::size_of::<GpuLayer>() == LAYER_TEXELS * 16);
 
 /// Texels of `resolve.comp`'s `layers` image per layer.
-pub const LAYER_TEXELS: usize = 11;
+pub const LAYER_TEXELS: usize = 12;
+
+/// [`GpuLayer::levels`] of a layer whose mask is used as it is.
+const NO_LEVELS: [f32; 4] = [0.0, 1.0, 1.0, 0.0];
+
+fn gpu_levels(adjust: &MaskAdjust) -> [f32; 4] {
+    if adjust.levels_are_identity() {
+        NO_LEVELS
+    } else {
+        [adjust.black, adjust.white, adjust.gamma, 1.0]
+    }
+}
 
 impl GpuLayer {
     /// A lone layer of the default parameters, for objects no stack covers.
@@ -44,7 +60,17 @@ impl GpuLayer {
             invert: 0,
             opacity: 1.0,
             pad: 0,
+            levels: NO_LEVELS,
         }
+    }
+
+    /// The mask value `m` after the layer's levels, as `resolve.comp`'s `mask_levels`.
+    fn levelled(&self, m: f32) -> f32 {
+        let [black, white, gamma, on] = self.levels;
+        if on == 0.0 {
+            return m;
+        }
+        MaskAdjust { black, white, gamma, blur: 0.0 }.levels(m)
     }
 
     /// The layer's material at a pixel whose channel values `channel_value` gives: its own
@@ -211,7 +237,9 @@ impl PackedStacks {
             for (i, layer) in layers.iter().enumerate() {
                 // The bottom layer fills: its mask has no effect.
                 let mask = match &layer.mask {
-                    Some(name) if i > 0 => packed.channel_index(&format!("{MASK_PREFIX}{name}")),
+                    Some(name) if i > 0 => {
+                        packed.channel_index(&format!("{MASK_PREFIX}{}", layer.mask_adjust.channel_key(name)))
+                    }
                     _ => NONE,
                 };
                 let mut maps = [NONE; GPU_FLOATS];
@@ -229,6 +257,7 @@ impl PackedStacks {
                     invert: layer.invert as u32,
                     opacity: layer.opacity,
                     pad: 0,
+                    levels: if mask == NONE { NO_LEVELS } else { gpu_levels(&layer.mask_adjust) },
                 });
             }
             // An object with neither its own stack nor a default one, or with every layer
@@ -319,7 +348,7 @@ impl PackedStacks {
         let layers = &self.layers[stack.first_layer as usize..(stack.first_layer + stack.layer_count) as usize];
         let mut params = layers[0].material(&channel_value);
         for layer in &layers[1..] {
-            let m = if layer.mask >= 0 { channel_value(layer.mask as usize) } else { 1.0 };
+            let m = if layer.mask >= 0 { layer.levelled(channel_value(layer.mask as usize)) } else { 1.0 };
             let w = (layer.opacity * if layer.invert != 0 { 1.0 - m } else { m }).clamp(0.0, 1.0);
             params = params.mix(&layer.material(&channel_value), w);
         }
@@ -328,7 +357,7 @@ impl PackedStacks {
 
     /// [`PackedStacks::resolve_pixel`] at pixel `index` of the g-buffer the stacks were packed for.
     pub fn resolve_gbuffer_pixel(&self, gbuffer: &GBuffer, index: usize) -> Params {
-        let channel_value = |i: usize| gbuffer.layer_channel(&self.channels[i]).map_or(0.0, |values| values[index]);
+        let channel_value = |i: usize| gbuffer.stack_channel_at(&self.channels[i], index).unwrap_or(0.0);
         self.resolve_pixel(gbuffer.object_id[index], channel_value)
     }
 }
@@ -363,8 +392,9 @@ pub struct LayerWeight {
     pub contribution: f32,
 }
 
-/// Each layer's weight at a pixel whose mask values `mask_value` gives by name; `None` for a
-/// disabled layer. The same rule as [`PackedStacks::pack`] and `resolve.comp`: the lowest enabled
+/// Each layer's weight at a pixel whose mask values `mask_value` gives by channel key (the
+/// mask's name, or a blurred mask's key: [`MaskAdjust::channel_key`]); `None` for a disabled
+/// layer. Levels apply here. The same rule as [`PackedStacks::pack`] and `resolve.comp`: the lowest enabled
 /// layer fills, and each layer above mixes over the result of those below.
 pub fn layer_weights(stack: &ObjectStack, mask_value: impl Fn(&str) -> f32) -> Vec<Option<LayerWeight>> {
     let mut weights: Vec<Option<LayerWeight>> = vec![None; stack.layers.len()];
@@ -375,7 +405,7 @@ pub fn layer_weights(stack: &ObjectStack, mask_value: impl Fn(&str) -> f32) -> V
         let blend = match &layer.mask {
             _ if rank == 0 => 1.0,
             Some(name) => {
-                let m = mask_value(name);
+                let m = layer.mask_adjust.levels(mask_value(&layer.mask_adjust.channel_key(name)));
                 (layer.opacity * if layer.invert { 1.0 - m } else { m }).clamp(0.0, 1.0)
             }
             None => layer.opacity.clamp(0.0, 1.0),
@@ -384,6 +414,32 @@ pub fn layer_weights(stack: &ObjectStack, mask_value: impl Fn(&str) -> f32) -> V
         remaining *= 1.0 - blend;
     }
     weights
+}
+
+/// The mask channels a stack's layers read, by the key [`layer_weights`] asks for (blurred
+/// masks made once here), for callers that weigh the layers at many pixels.
+pub fn mask_channels<'g>(stack: &ObjectStack, gbuffer: &'g GBuffer) -> BTreeMap<String, std::borrow::Cow<'g, [f32]>> {
+    let keys = stack.layers.iter().filter_map(|l| l.mask.as_ref().map(|m| l.mask_adjust.channel_key(m)));
+    keys.filter_map(|key| Some((key.clone(), gbuffer.stack_channel(&format!("{MASK_PREFIX}{key}"))?))).collect()
+}
+
+/// Each layer's share of the blend ([`LayerWeight::contribution`]) at every pixel that `stack`
+/// of `look` shades, 0 elsewhere: the matte of where each layer shows, as the `layers` AOVs
+/// and the viewer's mask overlay give it.
+pub fn layer_shares(look: &Look, stack: &ObjectStack, gbuffer: &GBuffer) -> Vec<Vec<f32>> {
+    let mut values = vec![vec![0.0f32; gbuffer.pixel_count()]; stack.layers.len()];
+    let masks = mask_channels(stack, gbuffer);
+    for p in 0..gbuffer.pixel_count() {
+        let shades = look.stack_for(gbuffer.object_id[p]).unwrap_or(stack);
+        if gbuffer.coverage[p] <= 0.0 || !std::ptr::eq(shades, stack) {
+            continue;
+        }
+        let mask = |key: &str| masks.get(key).map_or(0.0, |m| m[p]);
+        for (i, weight) in layer_weights(stack, mask).into_iter().enumerate() {
+            values[i][p] = weight.map_or(0.0, |w| w.contribution);
+        }
+    }
+    values
 }
 
 #[cfg(test)]

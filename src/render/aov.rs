@@ -18,7 +18,7 @@
 use crate::gbuffer::GBuffer;
 use crate::lab::albedo::AlbedoTables;
 use crate::material::look::{Look, ObjectStack};
-use crate::material::stack::layer_weights;
+use crate::material::stack::layer_shares;
 use crate::material::{Param, Params};
 use crate::render::renderer::{Accumulate, Renderer, LOBES};
 use crate::Result;
@@ -347,16 +347,7 @@ fn layer_weight_layers(sources: &Sources) -> Vec<Layer> {
     let mut out = Vec::new();
     for stack in &look.objects {
         let label = stack_label(stack, g);
-        let mut values = vec![vec![0.0f32; g.pixel_count()]; stack.layers.len()];
-        for p in 0..g.pixel_count() {
-            if g.coverage[p] <= 0.0 || !std::ptr::eq(look.stack_for(g.object_id[p]).unwrap_or(stack), stack) {
-                continue;
-            }
-            let mask = |name: &str| g.masks.get(name).map_or(0.0, |m| m[p]);
-            for (i, weight) in layer_weights(stack, mask).into_iter().enumerate() {
-                values[i][p] = weight.map_or(0.0, |w| w.contribution);
-            }
-        }
+        let values = layer_shares(look, stack, g);
         let names = stack
             .layers
             .iter()
