@@ -743,3 +743,35 @@ fn a_preset_saved_over_one_a_layer_uses_becomes_what_it_resets_to() {
     doc.save_preset_in(dir.path(), &preset, true).unwrap();
     assert_eq!(doc.preset_value(ObjectRef::Default, 0, Param::Roughness), Value::Scalar(0.2));
 }
+
+/// A layer inserted into the stack (a preset dropped between two layers) goes at its index, the
+/// others keeping their order, as one undo step; an index past the top is refused.
+#[test]
+fn an_inserted_layer_goes_at_its_index() {
+    let mut doc = document();
+    let layers = |doc: &Document| doc.stack(BALL).unwrap().layers.clone();
+    let original = layers(&doc);
+
+    doc.apply(Edit::InsertLayer { object: BALL, preset: "chrome".into(), at: 1 }).unwrap();
+    let now = layers(&doc);
+    assert_eq!(now.len(), 4);
+    assert_eq!(now[0], original[0]);
+    assert_eq!(now[2..], original[1..], "the layers above move up one");
+    assert_eq!(now[1].preset.as_deref(), Some("chrome"));
+    assert_eq!(now[1].params, library::builtin("chrome").unwrap().params);
+    doc.apply(Edit::InsertLayer { object: BALL, preset: "wax".into(), at: 4 }).unwrap();
+    assert_eq!(layers(&doc)[4].preset.as_deref(), Some("wax"), "at the number of layers is on top");
+
+    assert!(doc.undo());
+    assert_eq!(layers(&doc), now);
+    assert!(doc.undo());
+    assert_eq!(layers(&doc), original);
+    assert!(!doc.can_undo(), "each insert is one step");
+
+    let error = doc.apply(Edit::InsertLayer { object: BALL, preset: "chrome".into(), at: 4 }).unwrap_err();
+    assert_eq!(error, "object 1 has 3 layers; a new layer goes at 0 to 3 (on top)");
+    let error = doc.apply(Edit::InsertLayer { object: BALL, preset: "golld".into(), at: 0 }).unwrap_err();
+    assert!(error.contains("no preset named 'golld'"), "{error}");
+    assert_eq!(layers(&doc), original);
+    assert!(!doc.can_undo());
+}

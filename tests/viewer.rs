@@ -135,6 +135,40 @@ fn layer_keys_duplicate_hide_and_remove_the_selected_layer() {
     assert_eq!(ball("removed.toml"), [(preset("blue-rubber"), true), (preset("gold"), true)]);
 }
 
+/// A layer renamed and its mask blurred and levelled are saved in the look; S solos the layer
+/// (the image is `render`'s of the look with that layer alone in its stack) and S again ends
+/// it; L tints where the selected layer shows.
+#[test]
+fn layers_are_renamed_adjusted_soloed_and_overlaid() {
+    let Some(case) = Case::new() else { return };
+    case.write(
+        "layer.script",
+        "select 1 1\nrename Gold trim\nmask-adjust 0.2 0.7 1.5 2\nsave-look adjusted.toml\nkey S\nwait-spp 4\n\
+         screenshot solo.png\nkey S\nwait-spp 4\nscreenshot plain.png\nkey L\nscreenshot overlay.png\n",
+    );
+    let output = case.view(&["look.toml", "--script", "layer.script", "--exit-after-spp", "4"]);
+    assert_success(&output);
+    let adjusted = Look::load(&case.path("adjusted.toml")).unwrap();
+    let gold = &adjusted.stack_for(1).unwrap().layers[1];
+    assert_eq!(gold.name.as_deref(), Some("Gold trim"));
+    let adjust = gold.mask_adjust;
+    assert_eq!((adjust.black, adjust.white, adjust.gamma, adjust.blur), (0.2, 0.7, 1.5, 2.0));
+
+    let soloed = LOOK.replace("preset = \"blue-rubber\"\n[[object.layer]]\n", "");
+    case.write("soloed.toml", &soloed);
+    let solo = case.screenshot_image(&output, "solo.png");
+    assert_matches_render(&solo, &case.render("soloed.toml", 4, "soloed.png"));
+    let plain = case.screenshot_image(&output, "plain.png");
+    assert_matches_render(&plain, &case.render("adjusted.toml", 4, "adjusted.png"));
+
+    // The overlay tints the striped ball orange where the gold shows, and nothing else.
+    let overlay = case.screenshot_image(&output, "overlay.png");
+    let tinted = overlay.pixels().zip(plain.pixels()).filter(|(o, p)| o[0] as i32 - p[0] as i32 > 30).count();
+    let bluer = overlay.pixels().zip(plain.pixels()).filter(|(o, p)| o[2] as i32 - p[2] as i32 > 2).count();
+    assert!(tinted > 500, "only {tinted} pixels tinted");
+    assert_eq!(bluer, 0, "the tint only adds orange");
+}
+
 /// `view --set` reaches every object, as `render --set` does, also on a look with no default
 /// stack: the pedestal (object 2), which has no stack of its own, takes the red too.
 #[test]
@@ -880,4 +914,31 @@ fn bad_compare_inputs_are_one_line_errors() {
         "{}",
         stderr(&output)
     );
+}
+
+/// The preset library docks beside the layer stack rather than over the image: opened with
+/// Ctrl+Shift+N it moves the image over by its width, and Escape closes it and gives the room
+/// back. (A window over the image would move nothing.)
+#[test]
+fn the_preset_library_docks_beside_the_stack_and_escape_closes_it() {
+    let Some(case) = Case::new() else { return };
+    case.write(
+        "library.script",
+        "zoom fit\nwait-spp 1\nscreenshot closed.png\nkey ctrl+shift+N\nwait-spp 1\nscreenshot open.png\n\
+         key Escape\nwait-spp 1\nscreenshot again.png\n",
+    );
+    let output = case.view(&["look.toml", "--script", "library.script", "--exit-after-spp", "1"]);
+    assert_success(&output);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    // The image's left edge in the window, from "the image is at X,Y size …".
+    let left = |name: &str| -> u32 {
+        let line = stdout.lines().find(|l| l.starts_with("lookdev: screenshot") && l.contains(name)).unwrap();
+        let at = line.split("the image is at ").nth(1).expect("the placement is reported");
+        at.split(',').next().unwrap().parse().unwrap_or_else(|_| panic!("no placement in: {line}"))
+    };
+    let (closed, open, again) = (left("closed.png"), left("open.png"), left("again.png"));
+    // The layer stack's panel is 400 points wide; the library, one thumbnail column at least.
+    assert!(open >= 400 + 96, "the image starts at {open} with the library open: {stdout}");
+    assert!(open > closed, "{stdout}");
+    assert_eq!(again, closed, "closed, the library gives the room back: {stdout}");
 }

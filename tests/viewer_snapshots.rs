@@ -289,3 +289,41 @@ fn restore_is_one_undoable_edit_of_look_and_settings() {
     assert!(document.redo());
     assert_eq!(document.look(), &kept_look);
 }
+
+/// `B` flips in place between the live image and the newest snapshot, and, while a snapshot is
+/// compared, between the comparison and the snapshot alone; each screenshot line says which
+/// image is on screen, and the flipped image is the snapshot's pixels where the live one was.
+#[test]
+fn b_flips_between_the_live_image_and_a_snapshot_in_place() {
+    let Some(case) = Case::new() else { return };
+    case.write(
+        "flip.script",
+        "wait-spp 4\nkey B\nscreenshot nothing.png\nsnapshot before\nselect 1 1\nset roughness 0.9\nwait-spp 4\n\
+         screenshot live.png\nkey B\nscreenshot flipped.png\nkey B\nscreenshot back.png\n\
+         compare snapshot before split\nkey B\nscreenshot split-flip.png\nkey B\nscreenshot split-return.png\n",
+    );
+    let output = view_wide(&case, &["look.toml", "--script", "flip.script", "--exit-after-spp", "4"]);
+    assert_success(&output);
+    // Nothing to flip to yet: the view says nothing of it.
+    assert!(!report(&output, "nothing.png").contains("showing"), "{}", report(&output, "nothing.png"));
+    let snapshot = image::open(case.path("look.snapshots/before.png")).unwrap().into_rgb8();
+    let live = case.screenshot_image(&output, "live.png");
+    assert_differs(&live, &snapshot, "the edit changes the image");
+    for (shot, says, image) in [
+        ("live.png", "; showing live", &live),
+        ("flipped.png", "; showing snapshot before", &snapshot),
+        ("back.png", "; showing live", &live),
+        ("split-flip.png", "; showing snapshot before", &snapshot),
+    ] {
+        let line = report(&output, shot);
+        assert!(line.contains(says), "{line}");
+        assert_matches_render(&case.screenshot_image(&output, shot), image);
+    }
+    // Where the live image was: the flip moves nothing.
+    let at = |shot: &str| {
+        report(&output, shot).split("the image is at ").nth(1).unwrap().split(';').next().unwrap().to_string()
+    };
+    assert_eq!(at("flipped.png"), at("live.png"));
+    let line = report(&output, "split-return.png");
+    assert!(line.contains("; showing live | snapshot before") && line.contains("; split at image column"), "{line}");
+}

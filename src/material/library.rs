@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use super::preset::Preset;
-use crate::suggest::closest;
+use crate::suggest::{closest, edit_distance};
 
 /// The user's preset library: `$LOOKDEV_PRESETS` if set, else `$XDG_DATA_HOME/lookdev/presets`,
 /// else `~/.local/share/lookdev/presets`. None only without any of those variables.
@@ -283,6 +283,9 @@ pub enum MatchedBy {
     Tag(String),
     /// Only the description contains the query.
     Description,
+    /// Nothing contains the query, but it is a likely typo of this word of the name or of a
+    /// tag (see [`near_word`]).
+    Near(String),
 }
 
 impl std::fmt::Display for MatchedBy {
@@ -291,6 +294,7 @@ impl std::fmt::Display for MatchedBy {
             MatchedBy::Name => write!(f, "name"),
             MatchedBy::Tag(tag) => write!(f, "tag: {tag}"),
             MatchedBy::Description => write!(f, "in description"),
+            MatchedBy::Near(word) => write!(f, "close to: {word}"),
         }
     }
 }
@@ -298,8 +302,15 @@ impl std::fmt::Display for MatchedBy {
 /// How well a preset (its name, tags and description) matches `query`, case-insensitively:
 /// a rank (lower is better) and why; `None` when it does not match. The ranks: the name is the
 /// query, the name starts with it, the name contains it, a tag is the query, a tag contains it,
-/// the description contains it.
+/// the description contains it; then, when none of those, the query is a likely typo of a word
+/// of the name, then of a tag ([`near_word`]), so that "metl" finds the metals.
 pub fn search_match(query: &str, name: &str, tags: &[String], description: &str) -> Option<(u8, MatchedBy)> {
+    exact_match(query, name, tags, description).or_else(|| near_match(query, name, tags))
+}
+
+/// [`search_match`] without typos: the query is the name or a tag, or is part of one of them or
+/// of the description.
+fn exact_match(query: &str, name: &str, tags: &[String], description: &str) -> Option<(u8, MatchedBy)> {
     let query = query.trim().to_lowercase();
     let name = name.to_lowercase();
     if query.is_empty() || name == query {
@@ -318,6 +329,45 @@ pub fn search_match(query: &str, name: &str, tags: &[String], description: &str)
         return Some((4, MatchedBy::Tag(tag.clone())));
     }
     description.to_lowercase().contains(&query).then_some((5, MatchedBy::Description))
+}
+
+/// The typo ranks of [`search_match`]: 6 when the query is near a word of the name, 7 when
+/// near a tag or a word of one; why names the word (the whole tag, for a tag).
+fn near_match(query: &str, name: &str, tags: &[String]) -> Option<(u8, MatchedBy)> {
+    let query = query.trim().to_lowercase();
+    let name = name.to_lowercase();
+    if let Some(word) = words(&name).find(|word| near_word(&query, word)) {
+        return Some((6, MatchedBy::Near(word.to_string())));
+    }
+    let tag = tags.iter().find(|tag| words(&tag.to_lowercase()).any(|word| near_word(&query, word)))?;
+    Some((7, MatchedBy::Near(tag.clone())))
+}
+
+/// The words of a name or tag: "brushed-aluminium" is "brushed" and "aluminium".
+fn words(text: &str) -> impl Iterator<Item = &str> {
+    text.split(['-', '_', ' ']).filter(|word| !word.is_empty())
+}
+
+/// Whether `query` (lowercase) is likely a typo of `word`: within one edit (a letter left out,
+/// added, changed, or two neighbours swapped) for a query of 3 to 5 letters, two for a longer
+/// one; or, from 4 letters, within one edit of the word's beginning, so that a typo in a word
+/// not typed out yet ("alumn") finds it too. Queries under 3 letters are too short to tell a
+/// typo from another word.
+pub fn near_word(query: &str, word: &str) -> bool {
+    let length = query.chars().count();
+    if length < 3 {
+        return false;
+    }
+    let limit = if length <= 5 { 1 } else { 2 };
+    if edit_distance(query, word) <= limit {
+        return true;
+    }
+    // The beginnings of the word a letter shorter or longer than the query, as well as its own
+    // length: the typo may have dropped or doubled a letter.
+    let letters: Vec<char> = word.chars().collect();
+    length >= 4
+        && (length - 1..=(length + 1).min(letters.len()))
+            .any(|end| edit_distance(query, &letters[..end].iter().collect::<String>()) <= 1)
 }
 
 /// The presets among `items` that match `query`, best first (see [`search_match`]), in their
@@ -438,6 +488,81 @@ mod tests {
             .all(|(p, why)| *why == MatchedBy::Description && p.description.to_lowercase().contains(&word)));
         assert!(search(&presets, "no-preset-says-this", fields).is_empty());
         assert_eq!(search(&presets, "", fields).len(), presets.len(), "an empty query lists everything");
+    }
+
+    /// A typo finds what it meant, after every preset the query itself matches, and says so.
+    #[test]
+    fn search_tolerates_a_typo() {
+        let presets = builtins();
+        let metals: BTreeSet<&str> =
+            presets.iter().filter(|p| p.tags.iter().any(|t| t == "metal")).map(|p| p.name.as_str()).collect();
+        assert!(metals.len() > 3);
+        let found = search(&presets, "metl", fields);
+        let names: BTreeSet<&str> = found.iter().map(|(p, _)| p.name.as_str()).collect();
+        assert_eq!(names, metals, "'metl' finds the metals, and only them");
+        assert!(found.iter().all(|(_, why)| *why == MatchedBy::Near("metal".into())), "{found:?}");
+        assert_eq!(MatchedBy::Near("metal".into()).to_string(), "close to: metal");
+        // Swapped letters, a letter left out of a long word, a word of a name not typed out.
+        for (typo, meant) in [
+            ("glod", "gold"),
+            ("cpoper", "copper"),
+            ("alumnium", "aluminium"),
+            ("alumn", "aluminium"),
+            ("stainels", "stainless-steel"),
+        ] {
+            let found = search(&presets, typo, fields);
+            assert!(found.iter().any(|(p, _)| p.name == meant), "'{typo}' does not find {meant}: {found:?}");
+        }
+    }
+
+    /// Presets the query matches as typed come before any it is only close to.
+    #[test]
+    fn typos_rank_after_name_and_tag_matches() {
+        let item = |name: &str, tags: &[&str], description: &str| {
+            (name.to_string(), tags.iter().map(|t| t.to_string()).collect::<Vec<String>>(), description.to_string())
+        };
+        let items = [
+            item("x", &["glod"], ""),
+            item("gould", &[], ""),
+            item("leaf", &[], "gold leaf"),
+            item("cobalt", &["golden"], ""),
+            item("old-gild", &["gold"], ""),
+            item("gold", &[], ""),
+            item("silver", &["metal"], "not yellow"),
+        ];
+        let found = search(&items, "gold", |(name, tags, description)| (name, tags, description));
+        let order: Vec<(&str, String)> = found.iter().map(|(item, why)| (item.0.as_str(), why.to_string())).collect();
+        let expected = [
+            ("gold", "name"),
+            ("old-gild", "tag: gold"),
+            ("cobalt", "tag: golden"),
+            ("leaf", "in description"),
+            ("gould", "close to: gould"),
+            ("x", "close to: glod"),
+        ];
+        assert_eq!(order, expected.map(|(name, why)| (name, why.to_string())));
+        // A name one edit from the query ranks above a tag one edit from it.
+        let tags = ["glossy".to_string()];
+        let by_name = search_match("golb", "gold", &[], "").unwrap();
+        let by_tag = search_match("glosy", "other", &tags, "").unwrap();
+        assert_eq!(by_name.1, MatchedBy::Near("gold".into()));
+        assert_eq!(by_tag.1, MatchedBy::Near("glossy".into()));
+        assert!(by_name.0 < by_tag.0);
+        let exact = search_match("glossy", "other", &tags, "").unwrap();
+        let described = search_match("glossy", "other", &[], "a glossy coat").unwrap();
+        assert!(exact.0 < by_name.0 && described.0 < by_name.0);
+    }
+
+    #[test]
+    fn nonsense_and_short_queries_find_no_typos() {
+        let presets = builtins();
+        for query in ["qzxv", "xyz", "wolfram-zebra", "qj"] {
+            assert!(search(&presets, query, fields).is_empty(), "{query}: {:?}", search(&presets, query, fields));
+        }
+        assert!(!near_word("go", "gold"), "two letters are too few to call a typo");
+        assert!(near_word("gld", "gold"));
+        assert!(!near_word("glx", "gold"));
+        assert!(near_word("brsuhed", "brushed"), "two edits in a longer word");
     }
 
     #[test]

@@ -96,6 +96,11 @@ pub enum Action {
     RemoveEnvironmentFolder(PathBuf),
     /// Opens the environment browser (a script's `environments`).
     ShowEnvironments,
+    /// Shows the selected layer alone in its stack, or ends the solo (Painter's Alt+click on
+    /// the eye): a way of looking, not an edit.
+    Solo(bool),
+    /// Tints the image where the selected layer shows, or stops (`None`: toggles it).
+    MaskOverlay(Option<bool>),
 }
 
 /// What to show as B, beside the edited look (A).

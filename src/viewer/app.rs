@@ -9,6 +9,7 @@
 use super::action::{Action, Answer, Compare};
 use super::environments::EnvironmentLibrary;
 use super::gui::Gui;
+use super::mask_overlay::MaskOverlay;
 use super::presenter::Presenter;
 use super::schedule::{FrameScheduler, Next, Situation};
 use super::script::{ScriptRunner, Step};
@@ -173,6 +174,7 @@ struct Running {
     next_repaint: Option<Instant>,
     quit: bool,
     views: Views,
+    mask_overlay: MaskOverlay,
 }
 
 impl Running {
@@ -241,6 +243,7 @@ impl Running {
             next_repaint: None,
             quit: false,
             views: Views::default(),
+            mask_overlay: MaskOverlay::default(),
         };
         if let Some(warning) = warning {
             crate::warn(&warning);
@@ -348,6 +351,7 @@ impl Running {
         // B's textures now name only a live image (or none): a replaced B can go.
         self.session.drop_retired()?;
         self.views.update(&mut self.session, &self.gui.egui)?;
+        self.mask_overlay.update(&self.session, &self.gui.egui);
         let mut actions = Vec::new();
         let frame = Frame {
             session: &self.session,
@@ -356,6 +360,7 @@ impl Running {
             pending: self.pending.as_ref(),
             figures: FrameFigures { frame: self.clock.recent_mean() },
             views: &self.views,
+            mask_overlay: self.mask_overlay.texture(),
             environments: &self.environments,
         };
         let output =
@@ -659,6 +664,16 @@ impl Running {
                 self.interface.refresh_environments();
             }
             Action::ShowEnvironments => self.interface.show_environments(),
+            Action::Solo(on) => {
+                let (object, layer) = selected_layer(&self.session.document)?;
+                let stack = self.session.document.stack(object).expect("selected_layer() checked it");
+                let (id, label) = (stack.layers[layer].id, super::session::layer_label(&stack.layers[layer]));
+                self.session.solo = on.then_some(id);
+                self.session.sync()?;
+                let state = if on { format!("solo: {label} alone in {object}") } else { "solo off".to_string() };
+                return Ok(Some(state));
+            }
+            Action::MaskOverlay(on) => return Ok(Some(self.mask_overlay.set(on))),
             Action::Answer(answer) => {
                 let pending = self.pending.take().ok_or_else(|| Error::input("there is no question to answer"))?;
                 match answer {
@@ -756,6 +771,9 @@ impl Running {
                 placement += &format!("; split at image column {column} ({a} | {b})");
             }
             placement += &self.snapshot_report();
+            if let Some(showing) = self.interface.showing(&self.session) {
+                placement += &format!("; {showing}");
+            }
             if let Some(region) = self.session.restarted_region() {
                 placement += &format!("; {}", super::ui::region_status(region));
             }

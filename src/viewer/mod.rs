@@ -18,6 +18,7 @@ mod compare;
 mod delta_e;
 mod environments;
 mod gui;
+mod mask_overlay;
 mod presenter;
 mod progressive;
 mod schedule;

@@ -8,6 +8,7 @@ use super::action::{Action, Answer, Compare};
 use super::compare::SnapshotView;
 use crate::environment::backdrop::{self, Backdrop};
 use crate::environment::EnvironmentRef;
+use crate::material::mask::MaskAdjust;
 use crate::material::params::{parse_value, Param, Value};
 use crate::shading::tonemap::Tonemap;
 use crate::viewer_state::{Edit, ObjectRef, Selection};
@@ -34,7 +35,7 @@ pub enum Step {
 }
 
 /// A change to the selected layer.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum LayerChange {
     Set(Param, Value),
     Reset(Param),
@@ -44,6 +45,8 @@ pub enum LayerChange {
     Enabled(bool),
     Invert(bool),
     Opacity(f32),
+    MaskAdjust(MaskAdjust),
+    Rename(Option<String>),
 }
 
 impl LayerChange {
@@ -58,12 +61,15 @@ impl LayerChange {
             LayerChange::Enabled(enabled) => Edit::SetEnabled { object, layer, enabled },
             LayerChange::Invert(invert) => Edit::SetInvert { object, layer, invert },
             LayerChange::Opacity(opacity) => Edit::SetOpacity { object, layer, opacity },
+            LayerChange::MaskAdjust(adjust) => Edit::SetMaskAdjust { object, layer, adjust },
+            LayerChange::Rename(name) => Edit::RenameLayer { object, layer, name },
         }
     }
 }
 
 /// The commands, for the error that names an unknown one.
-const COMMANDS: &str = "select, set, reset, map, add, remove, duplicate, move, show, hide, mask, invert, opacity, \
+const COMMANDS: &str = "select, set, reset, map, add, remove, duplicate, move, show, hide, mask, mask-adjust, invert, \
+    opacity, rename, solo, overlay, \
     rotate, intensity, background, env, exposure, tonemap, spp, seed, undo, redo, pick, inspect, wait-spp, save-look, \
     save-preset, save-image, screenshot, open-look, quit, answer, compare, divider, key, zoom, view, clipping, probe, \
     snapshot, restore, delete-snapshot, denoise, visibility, catcher";
@@ -232,6 +238,24 @@ fn parse_step(command: &str, rest: &str) -> std::result::Result<Step, String> {
         "opacity" => {
             arity(1)?;
             layer(LayerChange::Opacity(float(args[0])?))
+        }
+        "mask-adjust" => {
+            arity(4)?;
+            let [black, white, gamma, blur] = [args[0], args[1], args[2], args[3]].map(float);
+            layer(LayerChange::MaskAdjust(MaskAdjust { black: black?, white: white?, gamma: gamma?, blur: blur? }))
+        }
+        "rename" => match rest {
+            "" => Err("'rename' needs a name ('rename none' goes back to the preset's)".to_string()),
+            "none" => layer(LayerChange::Rename(None)),
+            name => layer(LayerChange::Rename(Some(name.to_string()))),
+        },
+        "solo" => {
+            arity(1)?;
+            Ok(Step::Do(Action::Solo(switch(args[0])?)))
+        }
+        "overlay" => {
+            arity(1)?;
+            Ok(Step::Do(Action::MaskOverlay(Some(switch(args[0])?))))
         }
         "rotate" => {
             arity(1)?;

@@ -11,6 +11,7 @@ use crate::environment::backdrop::Prepared;
 use crate::environment::{Backdrop, Environment, EnvironmentRef, LoadOptions};
 use crate::gbuffer::GBuffer;
 use crate::gpu::{Context, Image};
+use crate::material::look::{LayerId, Look};
 use crate::material::params::Params;
 use crate::material::stack::{layer_weights, LayerWeight, PackedStacks};
 use crate::render::output::{self, OutputFormat};
@@ -31,6 +32,7 @@ const KEPT_ENVIRONMENTS: usize = 3;
 /// What the renderer was last given.
 struct Shown {
     material_revision: u64,
+    solo: Option<LayerId>,
     environment: Option<EnvironmentRef>,
     lighting: Lighting,
     backdrop: Backdrop,
@@ -152,6 +154,9 @@ pub struct Session {
     /// The sample count the display filter last ran at, `None` when it must run again (a
     /// change, a preview, other display settings).
     denoised_at: Option<u32>,
+    /// The layer shown alone in its stack ([`Look::soloed`]): a way of looking, not an edit, so
+    /// neither saved nor undone. It lapses when the layer leaves the look.
+    pub solo: Option<LayerId>,
 }
 
 /// A snapshot as B: which, how, and its ΔE map against the live image when shown as one.
@@ -219,6 +224,7 @@ impl Session {
             recorded,
             shown: Shown {
                 material_revision: document.material_revision(),
+                solo: None,
                 environment: settings.environment.clone(),
                 lighting: settings.lighting,
                 backdrop: settings.backdrop.clone(),
@@ -248,6 +254,7 @@ impl Session {
             denoise: false,
             visibility: true,
             denoised_at: None,
+            solo: None,
         })
     }
 
@@ -552,7 +559,11 @@ impl Session {
         let settings = self.document.settings().clone();
         let mut restarted = false;
         let mut restarted_locally = false;
-        let material_changed = everything || self.document.material_revision() != self.shown.material_revision;
+        // A solo whose layer has gone (removed, or undone) lapses.
+        self.solo = self.solo.filter(|&id| self.document.look().soloed(id).is_some());
+        let material_changed = everything
+            || self.document.material_revision() != self.shown.material_revision
+            || self.solo != self.shown.solo;
         // Whether anything but the materials changes every pixel's image.
         let whole = everything
             || settings.environment != self.shown.environment
@@ -562,7 +573,7 @@ impl Session {
             || settings.noise != self.shown.noise;
         if material_changed {
             let packed = PackedStacks::pack(
-                self.document.look(),
+                &self.rendered_look(),
                 self.objects.iter().copied(),
                 &self.gbuffer,
                 &self.gbuffer_name,
@@ -593,6 +604,7 @@ impl Session {
                 self.packed = packed;
             }
             self.shown.material_revision = self.document.material_revision();
+            self.shown.solo = self.solo;
         }
         if everything || settings.environment != self.shown.environment {
             self.load_environment(settings.environment.as_ref())?;
@@ -796,7 +808,10 @@ impl Session {
             self.gbuffer.masks.iter().map(|(name, values)| (name.clone(), values[index])).collect();
         let maps: Vec<(String, f32)> =
             self.gbuffer.maps.iter().map(|(name, values)| (name.clone(), values[index])).collect();
-        let mask_value = |name: &str| masks.iter().find(|(n, _)| n == name).map_or(0.0, |(_, v)| *v);
+        let mask_value = |key: &str| {
+            let channel = format!("{}{key}", crate::gbuffer::MASK_PREFIX);
+            self.gbuffer.stack_channel_at(&channel, index).unwrap_or(0.0)
+        };
         let shaded = coverage > 0.0;
         let stack = shaded.then(|| self.stack_of(object_id));
         let layers = match stack.and_then(|object| self.document.stack(object)) {
@@ -915,11 +930,20 @@ impl Session {
         })
     }
 
-    /// Snapshots the live image with the look and settings that made it. Returns its name.
+    /// The look as rendered: the document's, with the solo layer alone in its stack.
+    pub fn rendered_look(&self) -> std::borrow::Cow<'_, Look> {
+        match self.solo.and_then(|id| self.document.look().soloed(id)) {
+            Some(look) => std::borrow::Cow::Owned(look),
+            None => std::borrow::Cow::Borrowed(self.document.look()),
+        }
+    }
+
+    /// Snapshots the live image with the look and settings that made it (a soloed layer's
+    /// snapshot keeps the others hidden, as it shows them). Returns its name.
     pub fn take_snapshot(&mut self, name: Option<&str>) -> Result<String> {
         let name = self.snapshots.name_for_new(name)?;
         let capture = self.capture()?;
-        let (look, settings) = (self.document.look().clone(), self.document.settings().clone());
+        let (look, settings) = (self.rendered_look().into_owned(), self.document.settings().clone());
         let size = (self.width(), self.height());
         Ok(self.snapshots.add(name, &look, &settings, capture, size)?.name.clone())
     }
@@ -1021,9 +1045,9 @@ fn shown_image(renderer: &Renderer, denoise: bool) -> &Image {
     }
 }
 
-/// How a layer is named in the interface: its preset, or "custom".
+/// A layer's name in the panels: its own name, else its preset's, else "custom".
 pub fn layer_label(layer: &crate::material::look::Layer) -> String {
-    layer.preset.clone().unwrap_or_else(|| "custom".to_string())
+    layer.name.clone().or_else(|| layer.preset.clone()).unwrap_or_else(|| "custom".to_string())
 }
 
 #[cfg(test)]
@@ -1059,6 +1083,51 @@ mod tests {
         assert!(session.converged());
         let rows: Vec<u32> = (0..session.height()).map(|row| session.renderer.row_samples(row)).collect();
         assert!(rows.iter().all(|&n| n == 37), "{rows:?}");
+        drop(session);
+        drop(ctx);
+    }
+
+    /// A soloed layer alone fills its objects, other stacks are left alone, the look itself
+    /// (what is saved) keeps every layer, and the solo lapses when its layer is undone away.
+    #[test]
+    fn a_solo_shows_one_layer_alone_without_editing_the_look() {
+        use crate::viewer_state::Edit;
+        let ctx = Context::new(&ContextOptions::from_env(std::env::var("LOOKDEV_TEST_DEVICE").ok())).unwrap();
+        let mut session = session(&ctx, (48, 48));
+        let ball = ObjectRef::Id(crate::gbuffer::BALL_ID);
+        let gold = session.document.stack(ball).unwrap().layers[1].clone();
+        let look_before = session.document.look().clone();
+        let pixel = (0..session.gbuffer.pixel_count())
+            .find(|&i| session.gbuffer.object_id[i] == crate::gbuffer::BALL_ID && session.gbuffer.coverage[i] == 1.0)
+            .unwrap();
+        let pedestal = (0..session.gbuffer.pixel_count())
+            .find(|&i| {
+                session.gbuffer.object_id[i] == crate::gbuffer::PEDESTAL_ID && session.gbuffer.coverage[i] == 1.0
+            })
+            .unwrap();
+        let pedestal_before = session.packed.resolve_gbuffer_pixel(&session.gbuffer, pedestal);
+
+        session.solo = Some(gold.id);
+        session.sync().unwrap();
+        assert_eq!(session.packed.resolve_gbuffer_pixel(&session.gbuffer, pixel), gold.params, "gold fills the ball");
+        assert_eq!(session.packed.resolve_gbuffer_pixel(&session.gbuffer, pedestal), pedestal_before);
+        assert_eq!(*session.document.look(), look_before, "a solo is no edit");
+        assert!(!session
+            .rendered_look()
+            .objects
+            .iter()
+            .flat_map(|o| &o.layers)
+            .filter(|l| l.id != gold.id)
+            .all(|l| l.enabled));
+
+        // Duplicated then undone: the copy's solo lapses, and the stack blends again.
+        session.document.apply(Edit::DuplicateLayer { object: ball, layer: 1 }).unwrap();
+        session.solo = Some(session.document.stack(ball).unwrap().layers[2].id);
+        session.sync().unwrap();
+        session.document.undo();
+        session.sync().unwrap();
+        assert_eq!(session.solo, None);
+        assert_ne!(session.packed.resolve_gbuffer_pixel(&session.gbuffer, pixel), gold.params);
         drop(session);
         drop(ctx);
     }

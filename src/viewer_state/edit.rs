@@ -6,11 +6,15 @@ use std::fmt;
 use crate::environment::backdrop::{self, Backdrop};
 use crate::environment::EnvironmentRef;
 use crate::material::look::{EnvironmentSettings, Layer, Look, ObjectStack, RenderSettings};
+use crate::material::mask::MaskAdjust;
 use crate::material::params::{Param, Params, Value};
 use crate::render::settings::{Settings, DEFAULT_MIN_SPP, DEFAULT_SPP};
 use crate::render::Lighting;
 use crate::shading::model::Model;
 use crate::shading::tonemap::{Tonemap, MAX_EXPOSURE};
+
+/// The longest layer name, in characters.
+pub const MAX_LAYER_NAME: usize = 80;
 
 /// Which layer stack an edit is aimed at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -72,6 +76,14 @@ pub enum Edit {
         object: ObjectRef,
         preset: String,
     },
+    /// Adds a layer of a preset as [`Edit::AddLayer`] does, at index `at`: the layers from
+    /// `at` up move one up, and `at` = the number of layers puts it on top. A preset dropped
+    /// between two layers of the stack panel is this.
+    InsertLayer {
+        object: ObjectRef,
+        preset: String,
+        at: usize,
+    },
     /// Removes a layer. A stack keeps at least one layer, so removing the last is an error.
     RemoveLayer {
         object: ObjectRef,
@@ -113,6 +125,19 @@ pub enum Edit {
         object: ObjectRef,
         layer: usize,
         invert: bool,
+    },
+    /// The blur and levels of a layer's mask, checked as the look format checks them.
+    SetMaskAdjust {
+        object: ObjectRef,
+        layer: usize,
+        adjust: MaskAdjust,
+    },
+    /// Names a layer (`None`: back to its preset's name). A name is trimmed and must not be
+    /// empty or longer than [`MAX_LAYER_NAME`] characters.
+    RenameLayer {
+        object: ObjectRef,
+        layer: usize,
+        name: Option<String>,
     },
     /// In [0, 1].
     SetOpacity {
@@ -165,6 +190,7 @@ pub enum MergeKey {
     Param(ObjectRef, usize, Param),
     Opacity(ObjectRef, usize),
     Mask(ObjectRef, usize),
+    MaskAdjust(ObjectRef, usize),
     Rotation,
     Intensity,
     /// A background colour or blur being dragged.
@@ -182,6 +208,7 @@ impl Edit {
             Edit::SetParam { object, layer, param, .. } => Some(MergeKey::Param(object, layer, param)),
             Edit::SetOpacity { object, layer, .. } => Some(MergeKey::Opacity(object, layer)),
             Edit::SetMask { object, layer, .. } => Some(MergeKey::Mask(object, layer)),
+            Edit::SetMaskAdjust { object, layer, .. } => Some(MergeKey::MaskAdjust(object, layer)),
             Edit::SetRotation(_) => Some(MergeKey::Rotation),
             Edit::SetIntensity(_) => Some(MergeKey::Intensity),
             Edit::SetBackdrop(Backdrop::Colour(_) | Backdrop::Blurred(_)) => Some(MergeKey::Backdrop),
@@ -234,13 +261,12 @@ impl State {
                 Ok(())
             })?,
             Edit::AddLayer { object, preset } => next.edit_stack(object, |stack| {
-                if preset.trim().is_empty() {
-                    return Err("a layer's preset must not be empty".to_string());
-                }
-                let params = presets(&preset)?;
-                stack.layers.push(Layer { preset: Some(preset), params, ..Layer::filling(Params::default()) });
-                Ok(())
+                let top = stack.layers.len();
+                insert_layer(stack, object, preset, top, presets)
             })?,
+            Edit::InsertLayer { object, preset, at } => {
+                next.edit_stack(object, |stack| insert_layer(stack, object, preset, at, presets))?
+            }
             Edit::RemoveLayer { object, layer } => next.edit_stack(object, |stack| {
                 check_layer(object, layer, stack.layers.len())?;
                 if stack.layers.len() == 1 {
@@ -286,6 +312,23 @@ impl State {
             })?,
             Edit::SetInvert { object, layer, invert } => next.edit_stack(object, |stack| {
                 layer_mut(stack, object, layer)?.invert = invert;
+                Ok(())
+            })?,
+            Edit::SetMaskAdjust { object, layer, adjust } => next.edit_stack(object, |stack| {
+                adjust.check()?;
+                layer_mut(stack, object, layer)?.mask_adjust = adjust;
+                Ok(())
+            })?,
+            Edit::RenameLayer { object, layer, name } => next.edit_stack(object, |stack| {
+                let name = name.map(|n| n.trim().to_string());
+                match &name {
+                    Some(n) if n.is_empty() => return Err("a layer's name must not be empty".to_string()),
+                    Some(n) if n.chars().count() > MAX_LAYER_NAME => {
+                        return Err(format!("a layer's name is at most {MAX_LAYER_NAME} characters"))
+                    }
+                    _ => {}
+                }
+                layer_mut(stack, object, layer)?.name = name;
                 Ok(())
             })?,
             Edit::SetOpacity { object, layer, opacity } => next.edit_stack(object, |stack| {
@@ -442,6 +485,27 @@ pub(super) fn check_layer(object: ObjectRef, layer: usize, count: usize) -> Resu
             "{object} has {count} layer{plural}; there is no layer {layer} (layers count from 0 at the bottom)"
         ))
     }
+}
+
+/// Puts a new layer of `preset` (a name or path, resolved by `presets`) at index `at` of the
+/// stack, `at` = the number of layers being the top.
+fn insert_layer(
+    stack: &mut ObjectStack,
+    object: ObjectRef,
+    preset: String,
+    at: usize,
+    presets: Presets,
+) -> Result<(), String> {
+    if preset.trim().is_empty() {
+        return Err("a layer's preset must not be empty".to_string());
+    }
+    let count = stack.layers.len();
+    if at > count {
+        return Err(format!("{object} has {count} layers; a new layer goes at 0 to {count} (on top)"));
+    }
+    let params = presets(&preset)?;
+    stack.layers.insert(at, Layer { preset: Some(preset), params, ..Layer::filling(Params::default()) });
+    Ok(())
 }
 
 fn layer_mut(stack: &mut ObjectStack, object: ObjectRef, layer: usize) -> Result<&mut Layer, String> {

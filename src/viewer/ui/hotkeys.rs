@@ -20,6 +20,8 @@ pub const HOTKEYS: &[Hotkey] = &[
     Hotkey { keys: "Ctrl+J", does: "Duplicate the selected layer (the copy is selected)" },
     Hotkey { keys: "Delete", does: "Remove the selected layer" },
     Hotkey { keys: "Ctrl+Comma", does: "Hide or show the selected layer (Ctrl+, as in Photoshop)" },
+    Hotkey { keys: "S", does: "Solo the selected layer (it alone fills its objects) or end the solo" },
+    Hotkey { keys: "L", does: "Mask overlay on or off: the image tinted where the selected layer shows" },
     Hotkey { keys: "Ctrl+Q", does: "Quit (asks about unsaved edits)" },
     Hotkey { keys: "F", does: "Fit the image to the view" },
     Hotkey { keys: "1", does: "Show the image at 1:1 (one image pixel per screen pixel)" },
@@ -29,6 +31,10 @@ pub const HOTKEYS: &[Hotkey] = &[
     Hotkey { keys: "E", does: "False-colour EV view on or off" },
     Hotkey { keys: "X", does: "Clipping overlay on or off" },
     Hotkey { keys: "P", does: "Take a snapshot of the image and its look" },
+    Hotkey {
+        keys: "B",
+        does: "Flip in place to the other image (the snapshot or B compared; else the last snapshot) and back",
+    },
     Hotkey { keys: "ArrowLeft / ArrowRight", does: "Previous / next environment in the library (an undoable edit)" },
     Hotkey { keys: "D", does: "Denoised display on or off (a display filter: never in saved images)" },
     Hotkey { keys: "O", does: "Shadows (the g-buffer's visibility) on or off, for comparison" },
@@ -44,6 +50,7 @@ pub const GESTURES: &[Hotkey] = &[
     Hotkey { keys: "Drag", does: "Pan the image; on the A/B divider, move the divider" },
     Hotkey { keys: "Wheel / pinch", does: "Zoom about the cursor" },
     Hotkey { keys: "Drag ☰", does: "Reorder a layer in the layer panel" },
+    Hotkey { keys: "Click a snapshot in the strip", does: "Compare it with the live image" },
     Hotkey { keys: "Drag a panel's edge", does: "Resize the panel" },
 ];
 

@@ -3,7 +3,8 @@
 
 use super::super::action::Action;
 use super::super::session::{layer_label, Session};
-use crate::material::look::{Layer, ObjectStack};
+use crate::material::look::{Layer, LayerId, ObjectStack};
+use crate::material::mask::{MaskAdjust, GAMMA_RANGE, MAX_BLUR};
 use crate::material::params::{Param, Value, GROUPS};
 use crate::material::physical;
 use crate::material::stack::bindable_maps;
@@ -38,7 +39,7 @@ pub fn show(ui: &mut egui::Ui, session: &Session, actions: &mut Vec<Action>) -> 
     if ui.checkbox(&mut catcher, "Shadow catcher").on_hover_text(hint).changed() {
         actions.push(Action::SetShadowCatcher(catcher));
     }
-    let add = layer_list(ui, object, stack, selection, actions);
+    let add = layer_list(ui, object, stack, selection, session.solo, actions);
     if let Some(index) = selection.layer.filter(|&i| i < stack.layers.len()) {
         ui.separator();
         layer_properties(ui, session, object, index, &stack.layers[index], actions);
@@ -84,12 +85,15 @@ fn add_button(ui: &mut egui::Ui) -> bool {
 
 /// The layer keys, as in Photoshop, which most artists' hands know: Ctrl+Shift+N adds a layer
 /// (from the library), Ctrl+J duplicates the selected one, Delete removes it, Ctrl+, hides or
-/// shows it. Returns true when the library should open.
+/// shows it; S solos it and L shows its mask overlay. Returns true when the library should open.
 pub fn shortcuts(input: &mut egui::InputState, session: &Session, actions: &mut Vec<Action>) -> bool {
     use egui::{Key, KeyboardShortcut, Modifiers};
     let document = &session.document;
     let selection = document.selection();
     let add = input.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::N));
+    if input.consume_key(Modifiers::NONE, Key::L) {
+        actions.push(Action::MaskOverlay(None));
+    }
     let (Some(object), Some(layer)) = (selection.object, selection.layer) else { return add };
     let Some(stack) = document.stack(object).filter(|s| layer < s.layers.len()) else { return add };
     if input.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::J)) {
@@ -102,6 +106,9 @@ pub fn shortcuts(input: &mut egui::InputState, session: &Session, actions: &mut 
     if input.consume_shortcut(&KeyboardShortcut::new(Modifiers::COMMAND, Key::Comma)) {
         actions.push(Action::Edit(Edit::SetEnabled { object, layer, enabled: !stack.layers[layer].enabled }));
     }
+    if input.consume_key(Modifiers::NONE, Key::S) {
+        actions.push(Action::Solo(session.solo != Some(stack.layers[layer].id)));
+    }
     add
 }
 
@@ -111,6 +118,7 @@ fn layer_list(
     object: ObjectRef,
     stack: &ObjectStack,
     selection: Selection,
+    solo: Option<LayerId>,
     actions: &mut Vec<Action>,
 ) -> bool {
     let count = stack.layers.len();
@@ -138,8 +146,19 @@ fn layer_list(
             let handle = ui.dnd_drag_source(egui::Id::new(("layer", index)), index, |ui| ui.label("☰")).response;
             handle.on_hover_text("Drag to move the layer");
             let mut enabled = layer.enabled;
-            if ui.checkbox(&mut enabled, "").on_hover_text("Show or hide the layer").changed() {
+            let soloed = solo == Some(layer.id);
+            let eye = ui.checkbox(&mut enabled, "").on_hover_text("Show or hide the layer; Alt+click solos it");
+            // Alt+click on the eye solos the layer, as in Substance Painter.
+            if eye.changed() && ui.input(|i| i.modifiers.alt) {
+                actions.push(Action::Select(Selection { object: Some(object), layer: Some(index) }));
+                actions.push(Action::Solo(!soloed));
+            } else if eye.changed() {
                 actions.push(Action::Edit(Edit::SetEnabled { object, layer: index, enabled }));
+            }
+            let solo_button = ui.selectable_label(soloed, "S").on_hover_text("Solo: show this layer alone (S)");
+            if solo_button.clicked() {
+                actions.push(Action::Select(Selection { object: Some(object), layer: Some(index) }));
+                actions.push(Action::Solo(!soloed));
             }
             let mut text = RichText::new(layer_summary(layer, index));
             if !layer.enabled {
@@ -153,10 +172,17 @@ fn layer_list(
         // The pointer's half of the row says where the layer goes: above the row or below it.
         let rect = row.response.rect;
         let above = ui.ctx().pointer_interact_pos().is_none_or(|p| p.y < rect.center().y);
+        // A preset dragged from the library goes into the gap the line shows, as a new layer.
+        // Before the layers' own drop: taking a payload of another type would lose it.
+        if let Some(preset) = super::browser::dropped_preset(&row.response) {
+            let at = if above { index + 1 } else { index };
+            actions.push(Action::Edit(Edit::InsertLayer { object, preset, at }));
+            actions.push(Action::Select(Selection { object: Some(object), layer: Some(at) }));
+        }
         if let Some(from) = row.response.dnd_release_payload::<usize>() {
             dropped = Some((*from, drop_index(*from, index, above)));
         }
-        if row.response.dnd_hover_payload::<usize>().is_some() {
+        if row.response.dnd_hover_payload::<usize>().is_some() || super::browser::preset_hovering(&row.response) {
             let y = if above { rect.top() } else { rect.bottom() };
             ui.painter().hline(rect.x_range(), y, egui::Stroke::new(2.0, ui.visuals().selection.bg_fill));
         }
@@ -182,12 +208,32 @@ fn drop_index(from: usize, onto: usize, above: bool) -> usize {
     }
 }
 
+/// What a mask's adjustments do, for the header that folds them away: "" when nothing.
+fn adjust_summary(adjust: &MaskAdjust) -> String {
+    let mut parts = Vec::new();
+    if adjust.blur > 0.0 {
+        parts.push(format!("blur {:.1} px", adjust.blur));
+    }
+    if !adjust.levels_are_identity() {
+        parts.push(format!("{:.2}–{:.2}, γ {:.2}", adjust.black, adjust.white, adjust.gamma));
+    }
+    if parts.is_empty() {
+        String::new()
+    } else {
+        format!(": {}", parts.join(", "))
+    }
+}
+
 /// "gold · stripes (inverted) · 60% · 2 maps".
 fn layer_summary(layer: &Layer, index: usize) -> String {
     let mut text = layer_label(layer);
     if index > 0 {
         if let Some(mask) = &layer.mask {
-            text += &format!(" · {mask}{}", if layer.invert { " (inverted)" } else { "" });
+            let adjusted = layer.mask_adjust != MaskAdjust::default();
+            let notes: Vec<&str> =
+                [(layer.invert, "inverted"), (adjusted, "adjusted")].into_iter().filter(|n| n.0).map(|n| n.1).collect();
+            let notes = if notes.is_empty() { String::new() } else { format!(" ({})", notes.join(", ")) };
+            text += &format!(" · {mask}{notes}");
         }
         if layer.opacity < 1.0 {
             text += &format!(" · {:.0}%", layer.opacity * 100.0);
@@ -210,6 +256,21 @@ fn layer_properties(
     actions: &mut Vec<Action>,
 ) {
     ui.heading(format!("Layer {index}: {}", layer_label(layer)));
+    ui.horizontal(|ui| {
+        ui.label("Name");
+        // Typing is one undo step (a gesture), ended by the next click; cleared, the layer
+        // takes its preset's name again.
+        let mut name = layer.name.clone().unwrap_or_default();
+        let hint = layer.preset.clone().unwrap_or_else(|| "custom".into());
+        let field = ui.add(egui::TextEdit::singleline(&mut name).hint_text(hint).desired_width(180.0));
+        if field.changed() {
+            let name = Some(name.trim().to_string()).filter(|n| !n.is_empty());
+            actions.push(Action::Drag(Edit::RenameLayer { object, layer: index, name }));
+        }
+        if field.lost_focus() {
+            actions.push(Action::EndGesture);
+        }
+    });
     if index == 0 {
         ui.label(RichText::new("The bottom layer fills the object: its mask and opacity do not apply.").weak());
     }
@@ -241,7 +302,44 @@ fn layer_properties(
             }
             ui.end_row();
         });
+        ui.add_enabled_ui(layer.mask.is_some(), |ui| mask_adjustments(ui, object, index, layer, actions));
     });
+}
+
+/// The mask's blur and levels, each a slider that keeps the others valid (black below white).
+fn mask_adjustments(ui: &mut egui::Ui, object: ObjectRef, index: usize, layer: &Layer, actions: &mut Vec<Action>) {
+    let current = layer.mask_adjust;
+    let mut adjust = current;
+    egui::CollapsingHeader::new(format!("Mask blur and levels{}", adjust_summary(&current)))
+        .id_salt("mask adjustments")
+        .show(ui, |ui| {
+            egui::Grid::new("mask adjustments grid").num_columns(2).show(ui, |ui| {
+                ui.label("Blur").on_hover_text("A Gaussian's σ, in g-buffer pixels");
+                ui.add(egui::Slider::new(&mut adjust.blur, 0.0..=MAX_BLUR).suffix(" px").max_decimals(1));
+                ui.end_row();
+                ui.label("Black").on_hover_text("The mask value that becomes 0");
+                ui.add(egui::Slider::new(&mut adjust.black, 0.0..=0.99).max_decimals(3));
+                ui.end_row();
+                ui.label("White").on_hover_text("The mask value that becomes 1");
+                ui.add(egui::Slider::new(&mut adjust.white, 0.01..=1.0).max_decimals(3));
+                ui.end_row();
+                ui.label("Gamma").on_hover_text("Above 1 widens the layer's reach, below 1 narrows it");
+                ui.add(egui::Slider::new(&mut adjust.gamma, GAMMA_RANGE).logarithmic(true).max_decimals(2));
+                ui.end_row();
+            });
+            if ui.button("Reset").clicked() {
+                adjust = MaskAdjust::default();
+            }
+        });
+    if adjust != current {
+        // Whichever point moved pushes the other along, so the pair stays ordered.
+        if adjust.black != current.black {
+            adjust.white = adjust.white.max(adjust.black + 0.01).min(1.0);
+        } else {
+            adjust.black = adjust.black.min(adjust.white - 0.01).max(0.0);
+        }
+        actions.push(Action::Drag(Edit::SetMaskAdjust { object, layer: index, adjust }));
+    }
 }
 
 fn parameters(
@@ -485,6 +583,19 @@ mod tests {
 
     /// Dropped above or below any layer, dragging up or down, a layer lands next to it, on the
     /// side the drop line showed, and the others keep their order.
+    /// A layer's own name replaces its preset's in the stack and the heading, and a layer whose
+    /// mask is adjusted says so in the stack.
+    #[test]
+    fn named_and_adjusted_layers_say_so() {
+        let look = "[[object]]\nid = 1\n[[object.layer]]\nname = \"Base coat\"\npreset = \"blue-rubber\"\n\
+                    [[object.layer]]\npreset = \"gold\"\nmask = \"stripes\"\nmask_blur = 2\n";
+        let texts = panel_texts(Some(look), ObjectRef::Id(1));
+        assert!(texts.iter().any(|t| t == "Base coat"), "{texts:?}");
+        assert!(texts.iter().any(|t| t == "Layer 0: Base coat"), "{texts:?}");
+        assert!(texts.iter().any(|t| t == "gold · stripes (adjusted)"), "{texts:?}");
+        assert!(!texts.iter().any(|t| t.contains("blue-rubber")), "the preset's name gives way: {texts:?}");
+    }
+
     #[test]
     fn a_dropped_layer_lands_where_the_line_shows() {
         let count = 4;

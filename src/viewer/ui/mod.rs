@@ -2,8 +2,9 @@
 //! document directly, so the panels and `--script` share one path.
 //!
 //! Layout: a menu bar, a status bar, the layer stacks on the left, light, render settings and
-//! the pixel inspector on the right, the image in the middle, and windows for the preset
-//! library, file choosing, saving a preset and the unsaved-edits question.
+//! the pixel inspector on the right, the preset library (when open) docked beside the layer
+//! stacks, the image in the middle with the strip of recent snapshots under it, and windows for
+//! file choosing, saving a preset and the unsaved-edits question.
 
 mod browser;
 mod compare;
@@ -14,6 +15,7 @@ mod inspector;
 mod layers;
 mod lighting;
 mod snapshots;
+mod strip;
 mod viewport;
 mod views;
 
@@ -34,6 +36,13 @@ const DENOISE_HINT: &str = "Shows the accumulation through an edge-avoiding filt
 /// What switching the visibility off does, where it is offered and marked.
 const VISIBILITY_HINT: &str = "Relights with the g-buffer's visibility (shadows and occlusion), or, off, as if every \
     direction above each pixel's horizon saw the sky, for comparison. Not saved with the look.";
+
+/// What the flip key (B) says when there is no other image.
+const NOTHING_TO_FLIP: &str = "Nothing to flip to: take a snapshot (P) or compare";
+
+/// The side panels' widths when first shown; the artist may resize them.
+const STACK_WIDTH: f32 = 400.0;
+const LIGHT_WIDTH: f32 = 300.0;
 
 /// How long a status message stays.
 const MESSAGE_TIME: Duration = Duration::from_secs(8);
@@ -69,6 +78,8 @@ pub struct Frame<'a> {
     pub figures: FrameFigures,
     /// The view shown instead of the beauty, its copy and textures.
     pub views: &'a Views,
+    /// The mask overlay's texture, while it is on.
+    pub mask_overlay: Option<egui::TextureId>,
     /// The environment library, for its browser.
     pub environments: &'a super::environments::EnvironmentLibrary,
 }
@@ -99,6 +110,12 @@ impl Interface {
         interface
     }
 
+    /// Which image is on screen, as the status bar says it: "showing snapshot NAME", "showing
+    /// live", "showing A | B", …
+    pub fn showing(&self, session: &Session) -> Option<String> {
+        self.snapshots.showing(session)
+    }
+
     /// Shows a message in the status bar.
     pub fn tell(&mut self, text: impl Into<String>, error: bool) {
         self.message = Some(Message { text: text.into(), error, since: Instant::now() });
@@ -125,20 +142,22 @@ impl Interface {
         egui::Panel::top("menu").show(ui, |ui| self.menu(ui, frame, actions));
         egui::Panel::bottom("status").show(ui, |ui| self.status(ui, frame));
         if !self.panels_hidden {
-            self.side_panels(ui, frame, actions);
+            self.side_panels(ui, frame, thumbnails, actions);
+            self.snapshots.strip(ui, frame.session, actions);
         }
-        let snapshot = self.snapshots.shown(frame.session);
-        // A snapshot split shows the snapshot's image as B.
-        let compare = snapshot.as_ref().map_or(frame.compare_texture, |s| Some(s.texture));
+        // A view other than the beauty shows in A's place (B, in a split, keeps its beauty); a
+        // snapshot compared is B; the flip (B) shows the other image alone.
+        let a = frame.views.texture().unwrap_or(frame.view_texture);
+        let drawn = self.snapshots.drawn(frame.session, a, frame.compare_texture);
         egui::CentralPanel::no_frame().show(ui, |ui| {
-            // A view other than the beauty shows in A's place (B, in a split, keeps its beauty).
-            let a = frame.views.texture().unwrap_or(frame.view_texture);
-            let placement = self.viewport.show(ui, frame.session, a, compare, snapshot.as_ref(), actions);
+            let placement = self.viewport.show(ui, frame.session, drawn.a, drawn.b, drawn.snapshot.as_ref(), actions);
             self.placement = Some(placement);
-            views::decorate(ui, frame.session, frame.views, self.viewport.image_rect);
+            match &drawn.flipped {
+                Some(label) => snapshots::flip_plate(ui, label, self.viewport.image_rect),
+                None => views::decorate(ui, frame.session, frame.views, frame.mask_overlay, self.viewport.image_rect),
+            }
         });
         let ctx = ui.ctx().clone();
-        self.browser.show(&ctx, frame.session, thumbnails, actions, &mut self.message);
         let library = frame.environments;
         if self.environments.show(&ctx, frame.session, library, thumbnails, actions, &mut self.message) {
             self.file_dialog = Some(FileDialog::new(FilePurpose::AddEnvironmentFolder));
@@ -164,12 +183,18 @@ impl Interface {
     }
 
     /// The layer stack on the left; lighting, comparison, inspector, histogram and snapshots on
-    /// the right.
-    fn side_panels(&mut self, ui: &mut egui::Ui, frame: &Frame, actions: &mut Vec<Action>) {
+    /// the right; the preset library, when open, beside the layer stack, in what they leave.
+    fn side_panels(
+        &mut self,
+        ui: &mut egui::Ui,
+        frame: &Frame,
+        thumbnails: &mut Thumbnails,
+        actions: &mut Vec<Action>,
+    ) {
         // Each side panel scrolls what does not fit, both ways, rather than growing with its
         // content: a wide value must not move the image.
         let scrolled = || egui::ScrollArea::both().auto_shrink([false, false]);
-        egui::Panel::left("stack").default_size(400.0).show(ui, |ui| {
+        let stack = egui::Panel::left("stack").default_size(STACK_WIDTH).show(ui, |ui| {
             scrolled().show(ui, |ui| {
                 let open_browser = layers::show(ui, frame.session, actions);
                 if open_browser {
@@ -177,7 +202,11 @@ impl Interface {
                 }
             })
         });
-        egui::Panel::right("light").default_size(300.0).show(ui, |ui| {
+        // A preset dropped on the panel but not between two layers goes on top.
+        if let Some(preset) = browser::dropped_preset(&stack.response) {
+            actions.push(Action::AddPresetLayer(preset));
+        }
+        egui::Panel::right("light").default_size(LIGHT_WIDTH).show(ui, |ui| {
             scrolled().show(ui, |ui| {
                 lighting::show(ui, frame.session, &mut self.file_dialog, &mut self.environments.open, actions);
                 ui.separator();
@@ -190,6 +219,7 @@ impl Interface {
                 self.snapshots.show(ui, frame.session, actions);
             })
         });
+        self.browser.show(ui, frame.session, thumbnails, actions, &mut self.message);
     }
 
     fn shortcuts(&mut self, ctx: &egui::Context, frame: &Frame, actions: &mut Vec<Action>) {
@@ -235,6 +265,10 @@ impl Interface {
             }
             if input.consume_key(Modifiers::NONE, Key::P) {
                 actions.push(Action::Snapshot(None));
+            }
+            // B, for the B image: RenderView-style flipping between two images in place.
+            if input.consume_key(Modifiers::NONE, Key::B) && !self.snapshots.flip(frame.session) {
+                self.message = Some(Message { text: NOTHING_TO_FLIP.into(), error: false, since: Instant::now() });
             }
             if input.consume_key(Modifiers::NONE, Key::D) {
                 actions.push(Action::Denoise(!frame.session.denoise));
@@ -322,6 +356,15 @@ impl Interface {
                 if ui.add(hide).clicked() {
                     self.panels_hidden = !self.panels_hidden;
                 }
+                let strip = egui::Button::selectable(!self.snapshots.strip_hidden, "Snapshot strip");
+                if ui.add(strip).on_hover_text("Recent snapshots under the image: a click compares one").clicked() {
+                    self.snapshots.strip_hidden = !self.snapshots.strip_hidden;
+                }
+                let flip = egui::Button::new("Flip to the other image").shortcut_text("B");
+                let can_flip = self.snapshots.can_flip(frame.session);
+                if ui.add_enabled(can_flip, flip).on_disabled_hover_text(NOTHING_TO_FLIP).clicked() {
+                    self.snapshots.flip(frame.session);
+                }
                 ui.separator();
                 let denoise =
                     egui::Button::selectable(frame.session.denoise, "Denoise (display filter)").shortcut_text("D");
@@ -362,6 +405,11 @@ impl Interface {
             let (samples, target) = (session.samples(), session.target());
             let state = if session.converged() { "done" } else { "rendering" };
             ui.label(format!("{samples} / {target} spp ({state})"));
+            if let Some(showing) = self.snapshots.showing(session) {
+                ui.separator();
+                ui.label(egui::RichText::new(showing).strong())
+                    .on_hover_text("B flips between this and the other image, in place");
+            }
             if let Some((active, noise)) = session.adaptive() {
                 ui.separator();
                 ui.label(format!("adaptive {}: {} px sampling", noise.threshold, grouped(active as usize)))

@@ -74,18 +74,26 @@ pub fn status(state: &Views, hovered: Option<(u32, u32)>) -> String {
     }
 }
 
-/// Over and by the image: the clipping overlay (on A's part in a split), and for a view other
+/// Over and by the image: the mask and clipping overlays (on A's part in a split), and for a view other
 /// than the beauty its name on a plate above the image's top-left corner, and for false colour
 /// the legend under the image. Plates sit outside the image where the view has room, so that
 /// the image's pixels stay as shown.
-pub fn decorate(ui: &egui::Ui, session: &Session, state: &Views, image: Option<Rect>) {
+pub fn decorate(
+    ui: &egui::Ui,
+    session: &Session,
+    state: &Views,
+    mask_overlay: Option<egui::TextureId>,
+    image: Option<Rect>,
+) {
     let Some(image) = image else { return };
     let view = ui.max_rect();
     let painter = ui.painter_at(view);
-    if let Some(overlay) = state.overlay() {
-        let u = session.split_column().map_or(1.0, |c| c as f32 / session.width() as f32);
-        let rect = Rect::from_min_max(image.min, pos2(image.min.x + image.width() * u, image.max.y));
-        painter.image(overlay, rect, Rect::from_min_max(pos2(0.0, 0.0), pos2(u, 1.0)), Color32::WHITE);
+    // Overlays cover A's part of a split only.
+    let u = session.split_column().map_or(1.0, |c| c as f32 / session.width() as f32);
+    let a_rect = Rect::from_min_max(image.min, pos2(image.min.x + image.width() * u, image.max.y));
+    let a_uv = Rect::from_min_max(pos2(0.0, 0.0), pos2(u, 1.0));
+    for overlay in [mask_overlay, state.overlay()].into_iter().flatten() {
+        painter.image(overlay, a_rect, a_uv, Color32::WHITE);
     }
     let current = state.current();
     let mut label = match current {
