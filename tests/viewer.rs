@@ -520,6 +520,28 @@ fn fit_magnifies_a_small_image_and_the_zoom_keys_work() {
     assert!(!bad.status.success() && text.contains("--zoom: zoom 'fitt' is neither 'fit' nor a scale"), "{text}");
 }
 
+/// Fitted, the image leaves the footer band (the hint line and the pixel readout) free even
+/// where the view's height limits it, as with the side panels hidden: no text over the image.
+#[test]
+fn a_fitted_image_leaves_the_footer_free() {
+    let Some(case) = Case::new() else { return };
+    case.write("footer.script", "key H\nzoom fit\nwait-spp 1\nscreenshot fit.png\n");
+    let output = case.view(&["look.toml", "--script", "footer.script", "--exit-after-spp", "1"]);
+    assert_success(&output);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let line = stdout.lines().find(|l| l.starts_with("lookdev: screenshot") && l.contains("fit.png")).unwrap();
+    let placement = line.split("the image is at ").nth(1).unwrap();
+    let numbers: Vec<f32> = placement
+        .split(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .filter(|s| !s.is_empty())
+        .map(|s| s.parse().unwrap())
+        .collect();
+    let (y, height) = (numbers[1], numbers[3]);
+    let window: f32 = WINDOW[1].parse().unwrap();
+    // Under the image: the footer band (24 points) and the status bar (at least 18).
+    assert!(window - (y + height) >= 24.0 + 18.0, "the image reaches {} of {window}: {line}", y + height);
+}
+
 /// A ball pixel inside the image, half in a stripe, so the gold layer's weight is telling.
 fn half_striped_ball_pixel(gbuffer: &GBuffer) -> usize {
     let stripes = &gbuffer.masks["stripes"];

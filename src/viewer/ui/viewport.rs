@@ -84,10 +84,12 @@ impl Viewport {
         let (w, h) = (session.width() as f32, session.height() as f32);
         // Fit fills the view both ways: a small g-buffer is magnified rather than left a postage
         // stamp (nearest filtering keeps its pixels sharp).
-        let fit = (view.width() * ppp / w).min(view.height() * ppp / h).clamp(MIN_SCALE, MAX_SCALE);
+        // Fitted, the image leaves the footer band free, so the hint line never lies on it.
+        let above_footer = Rect::from_min_max(view.min, pos2(view.max.x, (view.max.y - FOOTER).max(view.min.y + 1.0)));
+        let fit = fit_scale(above_footer, ppp, (w, h));
         let scale = self.scale.unwrap_or(fit);
         let size = vec2(w, h) * scale / ppp;
-        let centre = view.center() + self.pan;
+        let centre = if self.scale.is_none() { above_footer.center() } else { view.center() } + self.pan;
         // On whole window pixels, so that 1:1 shows each image pixel exactly once.
         let min = ((centre - size / 2.0).to_vec2() * ppp).round() / ppp;
         let image_rect = Rect::from_min_size(min.to_pos2(), size);
@@ -280,6 +282,12 @@ impl Viewport {
             }
         }
     }
+}
+
+/// The scale at which a `w × h` image fills `rect` one way and fits in it the other, within
+/// the zoom's bounds.
+fn fit_scale(rect: Rect, ppp: f32, (w, h): (f32, f32)) -> f32 {
+    (rect.width() * ppp / w).min(rect.height() * ppp / h).clamp(MIN_SCALE, MAX_SCALE)
 }
 
 /// The hint line under the image, longest first: the first that fits beside the pixel readout is
