@@ -40,6 +40,11 @@ layout(constant_id = 11) const uint VISIBILITY_SIDE = 0u;
 // (flagged in the resolved material) also sum their estimates as if the visibility blocked
 // nothing, into `unshadowed`, for finalize.comp to divide. 0: that image is a placeholder.
 layout(constant_id = 12) const uint SHADOW_CATCHER = 0u;
+// 1: the kernel writes backgrounds only (SOURCE_BACKGROUND), whatever the source. A CPU driver
+// pays the whole kernel's set-up per invocation, which for the background pass over every
+// pixel of a large image cost more than the preview's relighting; specialised, the rest of
+// the kernel is left out.
+layout(constant_id = 13) const uint BACKGROUND_ONLY = 0u;
 
 #include "common.glsl"
 #include "material.glsl"
@@ -457,7 +462,7 @@ void main() {
     }
     ivec2 size = imageSize(accumulation);
     ivec2 pixel;
-    if (pass.source == SOURCE_BACKGROUND) {
+    if (BACKGROUND_ONLY != 0u || pass.source == SOURCE_BACKGROUND) {
         write_background(list_texel(i, size.x));
         return;
     } else if (pass.source == SOURCE_PREVIEW) {

@@ -1196,7 +1196,7 @@ impl Specialization {
 pub struct Kernels {
     pub specialization: Specialization,
     resolve: crate::gpu::ComputePipeline,
-    relight: crate::gpu::ComputePipeline,
+    relight: crate::render::passes::relight::RelightPipelines,
     finalize: crate::gpu::ComputePipeline,
 }
 

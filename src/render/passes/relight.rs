@@ -146,6 +146,13 @@ pub struct Accumulate {
 /// The layers of the lobe sums, in `relight.comp`'s order.
 pub const LOBES: [&str; 4] = ["diffuse", "specular", "clearcoat", "sheen"];
 
+/// The relight kernel's pipelines for one specialisation: the kernel, and the same specialised
+/// to write backgrounds only.
+pub struct RelightPipelines {
+    pub relight: ComputePipeline,
+    pub background: ComputePipeline,
+}
+
 /// The relight kernel specialised for one BRDF model and one [`Accumulate`], bound to the
 /// targets and an environment.
 pub struct RelightPass {
@@ -153,6 +160,10 @@ pub struct RelightPass {
     set: DescriptorSet,
     environment_set: DescriptorSet,
     backdrop_set: DescriptorSet,
+    /// The kernel specialised to write backgrounds only, with its own sets: what background
+    /// pushes run on.
+    background: ComputePipeline,
+    background_sets: [DescriptorSet; 3],
     /// The model, with its energy table when it compensates.
     pub shading: Shading,
     pub accumulate: Accumulate,
@@ -173,11 +184,15 @@ impl RelightPass {
         lobes: LobesPresent,
         visibility_side: u32,
         shadow_catcher: bool,
-    ) -> Result<ComputePipeline> {
+    ) -> Result<RelightPipelines> {
         let mut constants = model.specialization().to_vec();
         constants.extend([accumulate.lobes as u32, accumulate.variance as u32, product as u32]);
         constants.extend([lobes.diffuse as u32, lobes.clearcoat as u32, visibility_side, shadow_catcher as u32]);
-        ComputePipeline::specialized(ctx, &shaders::RELIGHT, INTERFACE.sets, INTERFACE.push_size(), &constants)
+        let specialized = |background_only: u32| {
+            let constants = [&constants[..], &[background_only]].concat();
+            ComputePipeline::specialized(ctx, &shaders::RELIGHT, INTERFACE.sets, INTERFACE.push_size(), &constants)
+        };
+        Ok(RelightPipelines { relight: specialized(0)?, background: specialized(1)? })
     }
 
     /// The pass, with `pipeline` from [`RelightPass::pipeline`] for the same `model` and
@@ -185,7 +200,7 @@ impl RelightPass {
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: &Context,
-        pipeline: ComputePipeline,
+        pipelines: RelightPipelines,
         model: &Model,
         accumulate: Accumulate,
         gbuffer: &GpuGBuffer,
@@ -202,32 +217,38 @@ impl RelightPass {
             (EnergyTable::placeholder(), None)
         };
         let energy_buffer = Buffer::with_data(ctx, bytemuck::cast_slice(&table.values))?;
-        let set = pipeline.bind(
-            0,
-            &[
-                Binding::Image(&gbuffer.surface),
-                Binding::Image(&targets.resolved),
-                Binding::Image(&targets.accumulation),
-                Binding::Image(&targets.background),
-                Binding::Buffer(&energy_buffer),
-                Binding::Image(&targets.lobe_sums),
-                Binding::Image(&targets.moments),
-                Binding::Image(&lists.covered_image),
-                Binding::Image(&lists.restarted_image),
-                Binding::Buffer(&lists.active),
-                Binding::Image(&gbuffer.visibility),
-                Binding::Image(&targets.unshadowed),
-                Binding::Image(&targets.active_lists),
-                Binding::Buffer(&lists.active_rows),
-            ],
-        )?;
+        let RelightPipelines { relight: pipeline, background } = pipelines;
+        let bindings = [
+            Binding::Image(&gbuffer.surface),
+            Binding::Image(&targets.resolved),
+            Binding::Image(&targets.accumulation),
+            Binding::Image(&targets.background),
+            Binding::Buffer(&energy_buffer),
+            Binding::Image(&targets.lobe_sums),
+            Binding::Image(&targets.moments),
+            Binding::Image(&lists.covered_image),
+            Binding::Image(&lists.restarted_image),
+            Binding::Buffer(&lists.active),
+            Binding::Image(&gbuffer.visibility),
+            Binding::Image(&targets.unshadowed),
+            Binding::Image(&targets.active_lists),
+            Binding::Buffer(&lists.active_rows),
+        ];
+        let set = pipeline.bind(0, &bindings)?;
         let environment_set = pipeline.bind(1, &environment.bindings())?;
         let backdrop_set = pipeline.bind(2, &[Binding::Image(backdrop)])?;
+        let background_sets = [
+            background.bind(0, &bindings)?,
+            background.bind(1, &environment.bindings())?,
+            background.bind(2, &[Binding::Image(backdrop)])?,
+        ];
         Ok(RelightPass {
             pipeline,
             set,
             environment_set,
             backdrop_set,
+            background,
+            background_sets,
             shading: Shading::new(*model, energy),
             accumulate,
             _energy: energy_buffer,
@@ -237,22 +258,28 @@ impl RelightPass {
     /// Binds another environment.
     pub fn set_environment(&mut self, environment: &GpuEnvironment) -> Result<()> {
         self.environment_set = self.pipeline.bind(1, &environment.bindings())?;
+        self.background_sets[1] = self.background.bind(1, &environment.bindings())?;
         Ok(())
     }
 
     /// Binds another backdrop image (set 2).
     pub fn set_backdrop(&mut self, backdrop: &Image) -> Result<()> {
         self.backdrop_set = self.pipeline.bind(2, &[Binding::Image(backdrop)])?;
+        self.background_sets[2] = self.background.bind(2, &[Binding::Image(backdrop)])?;
         Ok(())
     }
 
     /// Records the pass over the invocations `push.first..push.end`, in as many dispatches as
     /// the workgroup limit needs. Their pixels are disjoint, so the dispatches need no barrier.
     pub fn record(&self, cmd: vk::CommandBuffer, push: &RelightPush) {
-        let sets = [&self.set, &self.environment_set, &self.backdrop_set];
+        let (pipeline, sets) = if push.source == Source::Background as u32 {
+            (&self.background, [&self.background_sets[0], &self.background_sets[1], &self.background_sets[2]])
+        } else {
+            (&self.pipeline, [&self.set, &self.environment_set, &self.backdrop_set])
+        };
         for (first, end, groups) in super::list_dispatches(push.first, push.end) {
             let chunk = RelightPush { first, end, ..*push };
-            self.pipeline.dispatch(cmd, &sets, bytemuck::bytes_of(&chunk), groups);
+            pipeline.dispatch(cmd, &sets, bytemuck::bytes_of(&chunk), groups);
         }
     }
 }
