@@ -864,7 +864,7 @@ fn each_side_of_the_split_compiles_its_relight_kernel_once() {
     let output = case.view_with_env(&args, &[("LOOKDEV_TIMINGS", "1")]);
     assert_success(&output);
     let stderr = String::from_utf8_lossy(&output.stderr);
-    let compiles = stderr.lines().filter(|l| l.contains("timing: pipeline relight")).count();
+    let compiles = stderr.lines().filter(|l| l.contains("timing: pipeline relight ")).count();
     assert_eq!(compiles, 2, "{stderr}");
 }
 

@@ -24,6 +24,9 @@ macro_rules! kernel {
 pub const RESOLVE: Kernel = kernel!("resolve");
 /// One progressive pass of MIS image-based lighting.
 pub const RELIGHT: Kernel = kernel!("relight");
+/// `relight.comp` specialised to write backgrounds only (`BACKGROUND_ONLY`), under a name of its
+/// own in timings and errors, so that a compile of the relight kernel proper counts as one.
+pub const RELIGHT_BACKGROUND: Kernel = Kernel { name: "relight-background", ..RELIGHT };
 /// Mean, composite over the background, and display pixels (exposure, tone map, sRGB).
 pub const FINALIZE: Kernel = kernel!("finalize");
 /// BRDF and pdf evaluation for the GPU-against-CPU tests.

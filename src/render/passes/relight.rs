@@ -188,11 +188,14 @@ impl RelightPass {
         let mut constants = model.specialization().to_vec();
         constants.extend([accumulate.lobes as u32, accumulate.variance as u32, product as u32]);
         constants.extend([lobes.diffuse as u32, lobes.clearcoat as u32, visibility_side, shadow_catcher as u32]);
-        let specialized = |background_only: u32| {
+        let specialized = |kernel: &shaders::Kernel, background_only: u32| {
             let constants = [&constants[..], &[background_only]].concat();
-            ComputePipeline::specialized(ctx, &shaders::RELIGHT, INTERFACE.sets, INTERFACE.push_size(), &constants)
+            ComputePipeline::specialized(ctx, kernel, INTERFACE.sets, INTERFACE.push_size(), &constants)
         };
-        Ok(RelightPipelines { relight: specialized(0)?, background: specialized(1)? })
+        Ok(RelightPipelines {
+            relight: specialized(&shaders::RELIGHT, 0)?,
+            background: specialized(&shaders::RELIGHT_BACKGROUND, 1)?,
+        })
     }
 
     /// The pass, with `pipeline` from [`RelightPass::pipeline`] for the same `model` and
