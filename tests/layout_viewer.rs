@@ -8,18 +8,6 @@ mod common;
 use common::viewer::*;
 use image::RgbImage;
 use lookdev::gbuffer::GBuffer;
-use std::process::Output;
-
-/// Where a screenshot line says the image is: `X,Y size WxH scale S`.
-fn placement(output: &Output, name: &str) -> String {
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    let line = stdout
-        .lines()
-        .find(|l| l.starts_with("lookdev: screenshot") && l.contains(name))
-        .unwrap_or_else(|| panic!("no screenshot {name}: {stdout}"));
-    let at = line.split("the image is at ").nth(1).expect("the placement is reported");
-    at.split([';', ')']).next().unwrap().to_string()
-}
 
 /// A name as long as a production asset's.
 fn long(stem: &str) -> String {

@@ -100,15 +100,10 @@ fn h_hides_the_side_panels_and_brings_them_back() {
     case.write("tab.script", "key H\nscreenshot hidden.png\nkey H\nscreenshot shown.png\n");
     let output = case.view(&["look.toml", "--script", "tab.script", "--exit-after-spp", "1"]);
     assert_success(&output);
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    let left = |shot: &str| -> u32 {
-        let line = stdout.lines().find(|l| l.contains(&format!("screenshot {shot}"))).unwrap();
-        let at = line.split("the image is at ").nth(1).unwrap();
-        at.split(',').next().unwrap().parse().unwrap()
-    };
-    let window: u32 = WINDOW[0].parse().unwrap();
-    assert_eq!(left("hidden.png"), (window - SIZE) / 2, "{stdout}");
-    assert!(left("shown.png") > left("hidden.png") + 40, "the left panel is back: {stdout}");
+    let left = |shot: &str| placement(&output, shot).x;
+    let window: f32 = WINDOW[0].parse().unwrap();
+    assert_eq!(left("hidden.png"), (window - SIZE as f32) / 2.0);
+    assert!(left("shown.png") > left("hidden.png") + 40.0, "the left panel is back");
 }
 
 /// The layer keys, through the interface as a real key press: Ctrl+J duplicates the selected
@@ -483,20 +478,12 @@ fn wide_values_move_neither_the_panels_nor_the_image() {
     );
     let output = case.view(&["look.toml", "--script", "wide.script", "--exit-after-spp", "1"]);
     assert_success(&output);
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    let placement = |name: &str| -> String {
-        let line = stdout.lines().find(|l| l.starts_with("lookdev: screenshot") && l.contains(name)).unwrap();
-        line.split("the image is at ").nth(1).expect("the placement is reported").to_string()
-    };
-    assert_eq!(placement("narrow.png"), placement("wide.png"), "{stdout}");
+    assert_eq!(placement(&output, "narrow.png"), placement(&output, "wide.png"));
 }
 
 /// The scale a screenshot line reports the image at.
 fn reported_scale(output: &Output, name: &str) -> f32 {
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    let line = stdout.lines().find(|l| l.starts_with("lookdev: screenshot") && l.contains(name)).unwrap();
-    let scale = line.split(" scale ").nth(1).and_then(|s| s.split([';', ')']).next());
-    scale.unwrap().trim().parse().unwrap_or_else(|_| panic!("no scale in: {line}"))
+    placement(output, name).scale
 }
 
 /// Fit magnifies an image smaller than the view (a 160² g-buffer fills the middle of the
@@ -528,18 +515,10 @@ fn a_fitted_image_leaves_the_footer_free() {
     case.write("footer.script", "key H\nzoom fit\nwait-spp 1\nscreenshot fit.png\n");
     let output = case.view(&["look.toml", "--script", "footer.script", "--exit-after-spp", "1"]);
     assert_success(&output);
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    let line = stdout.lines().find(|l| l.starts_with("lookdev: screenshot") && l.contains("fit.png")).unwrap();
-    let placement = line.split("the image is at ").nth(1).unwrap();
-    let numbers: Vec<f32> = placement
-        .split(|c: char| !(c.is_ascii_digit() || c == '.'))
-        .filter(|s| !s.is_empty())
-        .map(|s| s.parse().unwrap())
-        .collect();
-    let (y, height) = (numbers[1], numbers[3]);
+    let Placement { y, height, .. } = placement(&output, "fit.png");
     let window: f32 = WINDOW[1].parse().unwrap();
     // Under the image: the footer band (24 points) and the status bar (at least 18).
-    assert!(window - (y + height) >= 24.0 + 18.0, "the image reaches {} of {window}: {line}", y + height);
+    assert!(window - (y + height) >= 24.0 + 18.0, "the image reaches {} of {window}", y + height);
 }
 
 /// A ball pixel inside the image, half in a stripe, so the gold layer's weight is telling.
@@ -951,16 +930,10 @@ fn the_preset_library_docks_beside_the_stack_and_escape_closes_it() {
     );
     let output = case.view(&["look.toml", "--script", "library.script", "--exit-after-spp", "1"]);
     assert_success(&output);
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    // The image's left edge in the window, from "the image is at X,Y size …".
-    let left = |name: &str| -> u32 {
-        let line = stdout.lines().find(|l| l.starts_with("lookdev: screenshot") && l.contains(name)).unwrap();
-        let at = line.split("the image is at ").nth(1).expect("the placement is reported");
-        at.split(',').next().unwrap().parse().unwrap_or_else(|_| panic!("no placement in: {line}"))
-    };
+    let left = |name: &str| placement(&output, name).x;
     let (closed, open, again) = (left("closed.png"), left("open.png"), left("again.png"));
     // The layer stack's panel is 400 points wide; the library, one thumbnail column at least.
-    assert!(open >= 400 + 96, "the image starts at {open} with the library open: {stdout}");
-    assert!(open > closed, "{stdout}");
-    assert_eq!(again, closed, "closed, the library gives the room back: {stdout}");
+    assert!(open >= 400.0 + 96.0, "the image starts at {open} with the library open");
+    assert!(open > closed);
+    assert_eq!(again, closed, "closed, the library gives the room back");
 }

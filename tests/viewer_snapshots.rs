@@ -320,10 +320,7 @@ fn b_flips_between_the_live_image_and_a_snapshot_in_place() {
         assert_matches_render(&case.screenshot_image(&output, shot), image);
     }
     // Where the live image was: the flip moves nothing.
-    let at = |shot: &str| {
-        report(&output, shot).split("the image is at ").nth(1).unwrap().split(';').next().unwrap().to_string()
-    };
-    assert_eq!(at("flipped.png"), at("live.png"));
+    assert_eq!(placement(&output, "flipped.png"), placement(&output, "live.png"));
     let line = report(&output, "split-return.png");
     assert!(line.contains("; showing live | snapshot before") && line.contains("; split at image column"), "{line}");
 }

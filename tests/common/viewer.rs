@@ -120,23 +120,42 @@ impl Case {
 
     /// The image part of a screenshot the viewer reported taking.
     pub fn screenshot_image(&self, output: &Output, name: &str) -> RgbImage {
-        let stdout = String::from_utf8_lossy(&output.stdout);
-        let line = stdout
-            .lines()
-            .find(|l| l.starts_with("lookdev: screenshot") && l.contains(name))
-            .unwrap_or_else(|| panic!("no screenshot reported: {stdout}"));
-        let placement = line.split("the image is at ").nth(1).expect("the placement is reported");
-        let placement = placement.split(';').next().unwrap();
-        let numbers: Vec<f32> = placement
-            .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
-            .filter(|s| !s.is_empty())
-            .map(|s| s.parse().unwrap())
-            .collect();
-        let [x, y, width, height, scale] = numbers[..] else { panic!("bad placement: {line}") };
-        assert_eq!((width, height, scale), (SIZE as f32, SIZE as f32, 1.0), "the image is shown 1:1: {line}");
+        let Placement { x, y, width, height, scale } = placement(output, name);
+        assert_eq!((width, height, scale), (SIZE as f32, SIZE as f32, 1.0), "the image is shown 1:1 in {name}");
         let window = image::open(self.path(name)).unwrap().into_rgb8();
         image::imageops::crop_imm(&window, x as u32, y as u32, SIZE, SIZE).to_image()
     }
+}
+
+/// Where a screenshot's report line says the image sits in the window, in window pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    pub x: f32,
+    pub y: f32,
+    pub width: f32,
+    pub height: f32,
+    pub scale: f32,
+}
+
+/// The placement the viewer reported for screenshot `name`:
+/// `lookdev: screenshot NAME (… the image is at X,Y size WxH scale S; …)`.
+pub fn placement(output: &Output, name: &str) -> Placement {
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("lookdev: screenshot") && l.contains(name))
+        .unwrap_or_else(|| panic!("no screenshot {name} reported: {stdout}"));
+    let at = line.split("the image is at ").nth(1).expect("the placement is reported");
+    let numbers: Vec<f32> = at
+        .split([';', ')'])
+        .next()
+        .unwrap()
+        .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+        .filter(|s| !s.is_empty())
+        .map(|s| s.parse().unwrap())
+        .collect();
+    let [x, y, width, height, scale] = numbers[..] else { panic!("bad placement: {line}") };
+    Placement { x, y, width, height, scale }
 }
 
 pub fn stderr(output: &Output) -> String {
